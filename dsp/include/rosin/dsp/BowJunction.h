@@ -1,0 +1,203 @@
+// The bow-string contact: intersects the load line v = vh + f/(2 Zeff) with the friction law
+// of the chosen model, sample by sample, without allocation (PHYSICS.md 2.2-2.3, 3.7, 4.4).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "Config.h"
+#include "FrictionLaws.h"
+#include "TemperatureLaw.h"
+#include "ThermalContact.h"
+
+namespace rosin::dsp {
+
+enum class FrictionModel {
+    FrictionCurve, ///< mu depends on sliding speed only, with the stick/slip jump rule
+    Thermal,       ///< mu depends on contact temperature only (Woodhouse 2003)
+    Enhanced       ///< mu = y(theta) h(|dv|), temperature and speed (Woodhouse & Galluzzo 2025)
+};
+
+struct FrictionParams {
+    FrictionModel model = FrictionModel::Thermal;
+    SteadyFit fit = SteadyFit::SmithWoodhouse;
+    SpeedFunction speedFunction = SpeedFunction::Rod;
+    ContactLaw contactLaw = ContactLaw::Amontons;
+    double contactExponent = 2.0 / 3.0;
+    ThermalParams thermal;
+};
+
+enum class ContactState { Stick, SlipForward, SlipBackward };
+
+template <typename T>
+struct JunctionResult {
+    T force;        ///< friction force on the string f (N)
+    T velocity;     ///< string surface velocity at the bow v (m/s)
+    T temperature;  ///< contact temperature rise theta (K)
+    bool stick;
+};
+
+template <typename T>
+class BowJunction {
+public:
+    /// [setup thread] Builds the temperature tables for the chosen model.
+    void prepare(double sampleRate, const FrictionParams& params)
+    {
+        params_ = params;
+        area_.configure(params.contactLaw, params.contactExponent, params.thermal);
+        if (params.model == FrictionModel::Thermal) law_.build(params.fit, std::nullopt, params.thermal);
+        if (params.model == FrictionModel::Enhanced) law_.build(params.fit, params.speedFunction, params.thermal);
+        thermal_.prepare(sampleRate, params.thermal);
+        reset();
+    }
+
+    void reset() noexcept
+    {
+        thermal_.reset();
+        state_ = ContactState::Stick;
+        xPrev_ = 0.0;
+        heatPrev_ = 0.0;
+        slidePrev_ = 0.0;
+        heatSlopePrev_ = 0.0;
+    }
+
+    /// [audio thread] Solve this sample. vh: history velocity; vb: bow speed; fb: bow force;
+    /// zEff: impedance seen by the bow. Non-finite inputs are treated as zero.
+    JunctionResult<T> solve(T vhIn, T vbIn, T fbIn, double zEff) noexcept
+    {
+        const double vh = finiteOr(vhIn), vb = std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed);
+        const double fb = std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce);
+        const double load = area_.effectiveLoad(fb);
+        const double twoZ = 2.0 * zEff;
+        const double D = vb - vh;
+        const double side = D >= 0.0 ? 1.0 : -1.0;
+        const double fStick = twoZ * D;
+
+        double theta = 0.0, f = 0.0;
+        if (params_.model != FrictionModel::FrictionCurve)
+            theta = thermal_.step(heatPrev_, slidePrev_, area_.area(fb), heatSlopePrev_);
+
+        if (params_.model == FrictionModel::Thermal) {
+            const double limit = load * law_(theta);
+            if (std::abs(fStick) <= limit) { f = fStick; state_ = ContactState::Stick; }
+            else { f = side * limit; state_ = side > 0 ? ContactState::SlipForward : ContactState::SlipBackward; }
+        } else {
+            const double scale = params_.model == FrictionModel::Enhanced ? law_(theta) : 1.0;
+            f = solveWithJumpRule(D, fStick, load, scale, twoZ);
+        }
+        const double v = state_ == ContactState::Stick ? vb : vh + f / twoZ;
+        const double dv = std::abs(v - vb);
+        heatPrev_ = std::abs(f) * dv;
+        slidePrev_ = dv;
+        // d(heat)/d(theta) at fixed sliding speed, for the semi-implicit thermal step.
+        heatSlopePrev_ = 0.0;
+        if (dv > 0.0 && params_.model == FrictionModel::Thermal) heatSlopePrev_ = load * dv * law_.slope(theta);
+        if (dv > 0.0 && params_.model == FrictionModel::Enhanced)
+            heatSlopePrev_ = load * dv * speedFunction(params_.speedFunction, dv).mu * law_.slope(theta);
+        return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), state_ == ContactState::Stick};
+    }
+
+    /// Largest friction force the contact can hold without slipping at temperature theta and
+    /// bow force fb (the stick limit), for tests and diagnostics.
+    double stickLimit(double fb, double theta) const noexcept
+    {
+        const double load = area_.effectiveLoad(fb);
+        switch (params_.model) {
+        case FrictionModel::FrictionCurve: return load * steadySliding(params_.fit, 0.0).mu;
+        case FrictionModel::Thermal: return load * law_(theta);
+        case FrictionModel::Enhanced: return load * law_(theta) * speedFunction(params_.speedFunction, 0.0).mu;
+        }
+        return 0.0;
+    }
+
+    /// mu(x) at zero temperature scale; the speed law used with the jump rule.
+    MuSlope speedLaw(double x) const noexcept
+    {
+        return params_.model == FrictionModel::Enhanced ? speedFunction(params_.speedFunction, x)
+                                                        : steadySliding(params_.fit, x);
+    }
+
+    ContactState state() const noexcept { return state_; }
+    double temperature() const noexcept { return thermal_.temperature(); }
+    const TemperatureLaw& temperatureLaw() const noexcept { return law_; }
+    const ContactArea& contactArea() const noexcept { return area_; }
+    const FrictionParams& params() const noexcept { return params_; }
+    ThermalContact<T>& thermal() noexcept { return thermal_; }
+
+private:
+    static double finiteOr(T x) noexcept { return std::isfinite(static_cast<double>(x)) ? static_cast<double>(x) : 0.0; }
+
+    /// Friction-curve and enhanced models: mu(x) = scale * law(x) falls with sliding speed, so
+    /// the load line may cut it three times; the McIntyre-Woodhouse hysteresis rule picks one.
+    double solveWithJumpRule(double D, double fStick, double load, double scale, double twoZ) noexcept
+    {
+        const double muStatic = scale * speedLaw(0.0).mu;
+        const bool canStick = std::abs(fStick) <= muStatic * load;
+        const double side = D >= 0.0 ? 1.0 : -1.0;
+        if (state_ == ContactState::Stick) {
+            if (canStick) return fStick;
+            return slipOn(side, D, load, scale, twoZ, 0.0);
+        }
+        const double sidePrev = state_ == ContactState::SlipForward ? 1.0 : -1.0;
+        if (auto x = outerRoot(sidePrev * D, load, scale, twoZ, xPrev_)) return commitSlip(sidePrev, *x, load, scale);
+        if (canStick) { state_ = ContactState::Stick; xPrev_ = 0.0; return fStick; }
+        return slipOn(-sidePrev, D, load, scale, twoZ, 0.0);
+    }
+
+    double slipOn(double side, double D, double load, double scale, double twoZ, double guess) noexcept
+    {
+        if (auto x = outerRoot(side * D, load, scale, twoZ, guess)) return commitSlip(side, *x, load, scale);
+        // Only reachable with zero load (nothing holds the string): the string runs free.
+        state_ = side > 0 ? ContactState::SlipForward : ContactState::SlipBackward;
+        xPrev_ = std::abs(D);
+        return 0.0;
+    }
+
+    double commitSlip(double side, double x, double load, double scale) noexcept
+    {
+        state_ = side > 0 ? ContactState::SlipForward : ContactState::SlipBackward;
+        xPrev_ = x;
+        return side * load * scale * speedLaw(x).mu;
+    }
+
+    /// Largest root of g(x) = 2Z(d - x) - load*scale*mu(x) on (0, d]. mu is convex and falling,
+    /// so g is concave: Newton from the right of the largest root walks down to it without
+    /// overshoot, and meeting g' >= 0 first means there is no root.
+    std::optional<double> outerRoot(double d, double load, double scale, double twoZ, double guess) const noexcept
+    {
+        if (!(d > 0.0)) return std::nullopt;
+        const double k = load * scale;
+        if (k <= 0.0) return std::nullopt;
+        auto eval = [&](double x, double& g, double& gp) {
+            const MuSlope m = speedLaw(x);
+            g = twoZ * (d - x) - k * m.mu;
+            gp = -twoZ - k * m.slope;
+        };
+        double x = d, g = 0.0, gp = 0.0;
+        if (guess > 0.0 && guess < d) {
+            eval(guess, g, gp);
+            if (g <= 0.0 && gp < 0.0) x = guess;
+        }
+        eval(x, g, gp);
+        for (int it = 0; it < 100; ++it) {
+            if (g == 0.0) return x;
+            if (gp >= 0.0) return std::nullopt;
+            const double next = x - g / gp;
+            if (next <= 0.0) return std::nullopt;
+            const bool done = std::abs(next - x) <= 1e-14 * (1.0 + d);
+            x = next;
+            eval(x, g, gp);
+            if (done) return x;
+        }
+        return x;
+    }
+
+    FrictionParams params_;
+    ContactArea area_;
+    TemperatureLaw law_;
+    ThermalContact<T> thermal_;
+    ContactState state_ = ContactState::Stick;
+    double xPrev_ = 0.0, heatPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePrev_ = 0.0;
+};
+
+} // namespace rosin::dsp

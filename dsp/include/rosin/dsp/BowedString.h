@@ -1,0 +1,89 @@
+// One bowed string: waveguide + bow junction, driven by physical controls every sample.
+#pragma once
+#include <cmath>
+
+#include "BowJunction.h"
+#include "StringWaveguide.h"
+
+namespace rosin::dsp {
+
+struct BowedStringConfig {
+    StringParams string = StringParams::celloD();
+    WaveguideOptions waveguide;
+    FrictionParams friction;
+};
+
+/// Everything the research outputs need about one sample (PHYSICS.md 6.9).
+template <typename T>
+struct BowFrame {
+    T bridgeForce = T(0);   ///< f_br (N)
+    T velocity = T(0);      ///< string surface velocity at the bow v (m/s)
+    T friction = T(0);      ///< friction force on the string f (N)
+    T temperature = T(0);   ///< contact rise theta (K)
+    T history = T(0);       ///< v_h (m/s)
+    bool stick = true;
+};
+
+template <typename T>
+class BowedString {
+public:
+    /// [setup thread] Allocates; call again when the string, model or rate changes.
+    void prepare(double sampleRate, const BowedStringConfig& config)
+    {
+        config_ = config;
+        waveguide_.prepare(sampleRate, config.string, config.waveguide);
+        junction_.prepare(sampleRate, config.friction);
+        zEff_ = waveguide_.effectiveImpedance();
+        reset();
+    }
+
+    void reset() noexcept
+    {
+        waveguide_.reset();
+        junction_.reset();
+    }
+
+    /// [audio thread] One sample. force (N), speed (m/s, signed), beta (bow position / L).
+    /// Returns the bridge force; fills `frame` when given.
+    T processSample(T force, T speed, T beta, BowFrame<T>* frame = nullptr) noexcept
+    {
+        waveguide_.setBeta(static_cast<double>(beta));
+        const T vh = waveguide_.beginSample();
+        const JunctionResult<T> r = junction_.solve(vh, speed, force, zEff_);
+        waveguide_.endSample(r.force);
+        const T out = waveguide_.bridgeForce();
+        if (frame) *frame = {out, r.velocity, r.force, r.temperature, vh, r.stick};
+        return out;
+    }
+
+    /// [audio thread] n samples; each control is an array (per-sample trajectories), so a
+    /// block split anywhere gives the same output.
+    void processBlock(const T* force, const T* speed, const T* beta, T* out, int n,
+                      BowFrame<T>* frames = nullptr) noexcept
+    {
+        for (int i = 0; i < n; ++i) out[i] = processSample(force[i], speed[i], beta[i], frames ? frames + i : nullptr);
+    }
+
+    /// [audio thread] Drive the string with a prescribed force instead of the bow (the pulse
+    /// tests and plucks). Returns the history velocity before the force acted.
+    T processForce(T f) noexcept
+    {
+        const T vh = waveguide_.beginSample();
+        waveguide_.endSample(f);
+        return vh;
+    }
+
+    const StringWaveguide<T>& waveguide() const noexcept { return waveguide_; }
+    StringWaveguide<T>& waveguide() noexcept { return waveguide_; }
+    const BowJunction<T>& junction() const noexcept { return junction_; }
+    double effectiveImpedance() const noexcept { return zEff_; }
+    const BowedStringConfig& config() const noexcept { return config_; }
+
+private:
+    BowedStringConfig config_;
+    StringWaveguide<T> waveguide_;
+    BowJunction<T> junction_;
+    double zEff_ = 0.5;
+};
+
+} // namespace rosin::dsp

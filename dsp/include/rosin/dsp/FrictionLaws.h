@@ -1,0 +1,104 @@
+// Steady-sliding friction fits, speed functions of the enhanced model, the contact-area law
+// and the thermal parameter set (PHYSICS.md 2.1, 3.8, 4.1, 5.3).
+#pragma once
+#include <cmath>
+#include <numbers>
+
+namespace rosin::dsp {
+
+/// A friction coefficient and its slope d(mu)/dx at sliding speed x >= 0.
+struct MuSlope {
+    double mu;
+    double slope;
+};
+
+enum class SteadyFit {
+    SmithWoodhouse,   ///< 0.4 e^{-v/0.01} + 0.45 e^{-v/0.1} + 0.35            [SW00; W03]
+    WoodhouseGalluzzo ///< 0.2 (v + 0.011)^{-0.4}, decays to zero at high speed [WG25 eq. 13]
+};
+
+inline MuSlope steadySliding(SteadyFit fit, double x) noexcept
+{
+    x = std::abs(x);
+    if (fit == SteadyFit::SmithWoodhouse) {
+        const double e1 = std::exp(-x / 0.01), e2 = std::exp(-x / 0.1);
+        return {0.4 * e1 + 0.45 * e2 + 0.35, -40.0 * e1 - 4.5 * e2};
+    }
+    const double p = std::pow(x + 0.011, -0.4);
+    return {0.2 * p, -0.4 * 0.2 * p / (x + 0.011)};
+}
+
+enum class SpeedFunction {
+    Bow, ///< h_bow = 0.5 (v + 0.27)^{-0.4}   [WG25 eq. 14]
+    Rod  ///< h_rod = 0.37 (v + 0.35)^{-0.4}  [WG25 eq. 15]
+};
+
+inline MuSlope speedFunction(SpeedFunction kind, double x) noexcept
+{
+    x = std::abs(x);
+    const double c = kind == SpeedFunction::Bow ? 0.5 : 0.37;
+    const double x0 = kind == SpeedFunction::Bow ? 0.27 : 0.35;
+    const double p = std::pow(x + x0, -0.4);
+    return {c * p, -0.4 * c * p / (x + x0)};
+}
+
+enum class ContactLaw {
+    Amontons, ///< real contact area proportional to load (many asperities, a bow)
+    PowerLaw  ///< A proportional to F^n; n = 2/3 is a single Hertzian contact (a rod)
+};
+
+/// Thermal and contact constants (PHYSICS.md 3.8 defaults; all are parameters, several are
+/// guesses in the literature).
+struct ThermalParams {
+    double contactRadiusAtRef = 250e-6;   ///< a at the reference load (m)        [W03 Table I]
+    double referenceLoad = 1.0;           ///< F_ref of the steady-sliding test (N) [A]
+    double layerThickness = 1e-6;         ///< rosin layer delta (m)              [W03]
+    double rosinHeatCapacity = 1.6e6;     ///< rho_r c_r (J m^-3 K^-1)            [A]
+    double stringEffusivity = 2050.0;     ///< e_s (W s^1/2 m^-2 K^-1)            [W03 Table I]
+    double rodEffusivity = 450.0;         ///< e_r, the moving bow/rod side       [W03 Table I]
+    double advectionWidthFactor = 2.0;    ///< w = factor * a                     [A]
+    double footprintRatio = 1.0;          ///< r_A = K_A(bow) / K_A(steady test)  [E9.6.3]
+    double ambientCelsius = 20.0;         ///< ambient of the simulation
+    double referenceAmbientCelsius = 20.0;///< ambient of the steady-sliding measurement
+    double glassTransitionCelsius = 49.0; ///< rosin of this preset
+    double referenceGlassTransitionCelsius = 49.0; ///< violin rosin of the measurement [seed]
+    double polesPerDecade = 2.0;          ///< conduction bank density
+    double xiMin = 0.3;                   ///< lowest pole (1/s)              [PHYSICS.md 3.4]
+    double xiMaxOverSampleRate = 30.0;    ///< highest pole / fs
+
+    /// Temperature offset added to the contact rise before looking up the friction law:
+    /// a warmer room, or a softer rosin (lower Tg), both act like a hotter contact.
+    double temperatureShift() const noexcept
+    {
+        return (ambientCelsius - referenceAmbientCelsius)
+               + (referenceGlassTransitionCelsius - glassTransitionCelsius);
+    }
+};
+
+/// Contact area as a function of bow force, shared by friction and heat balance so both see
+/// the same footprint. Friction = A * tau_y(theta), written as effectiveLoad * mu(theta).
+struct ContactArea {
+    ContactLaw law = ContactLaw::Amontons;
+    double exponent = 2.0 / 3.0;
+    double referenceLoad = 1.0;
+    double areaPerNewton = std::numbers::pi * 250e-6 * 250e-6; ///< K_A = A_ref / F_ref
+
+    void configure(ContactLaw l, double n, const ThermalParams& tp) noexcept
+    {
+        law = l;
+        exponent = n;
+        referenceLoad = tp.referenceLoad;
+        areaPerNewton = std::numbers::pi * tp.contactRadiusAtRef * tp.contactRadiusAtRef / tp.referenceLoad;
+    }
+
+    /// The load that multiplies mu: F itself (Amontons) or F_ref (F/F_ref)^n, equal at F_ref.
+    double effectiveLoad(double force) const noexcept
+    {
+        if (force <= 0.0) return 0.0;
+        if (law == ContactLaw::Amontons) return force;
+        return referenceLoad * std::pow(force / referenceLoad, exponent);
+    }
+    double area(double force) const noexcept { return areaPerNewton * effectiveLoad(force); }
+};
+
+} // namespace rosin::dsp

@@ -1,0 +1,206 @@
+// Digital-waveguide string seen from the bow (PHYSICS.md 1.1-1.5).
+//
+// The bow splits the string into a bridge side (length beta L) and a finger side. Each side is
+// a round trip of outgoing velocity waves through a delay and a reflection filter. The bridge
+// side is split in two halves so the bridge force is taken from the wave as it arrives there,
+// with all of that side's loss in the reflected path. Torsional waves run in their own pair of
+// lines with their own speed, impedance and damping; only transverse waves reach the bridge.
+//
+// Per sample: vh = beginSample(); solve the junction for f; endSample(f).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "Config.h"
+#include "DelayLine.h"
+#include "ReflectionFilter.h"
+#include "StringParams.h"
+
+namespace rosin::dsp {
+
+struct WaveguideOptions {
+    bool losses = true;       ///< frequency-dependent loss in both reflections
+    bool torsion = true;      ///< torsional waves (lower the load-line slope)
+    bool dispersion = false;  ///< bending-stiffness allpasses in the finger-side reflection
+    int dispersionSections = 2;
+};
+
+template <typename T>
+class StringWaveguide {
+public:
+    /// [setup thread] Allocates the delay lines for this string at this rate.
+    void prepare(double sampleRate, const StringParams& params, const WaveguideOptions& options = {})
+    {
+        fs_ = sampleRate;
+        params_ = params;
+        options_ = options;
+        z0_ = params.impedance();
+        zt_ = params.torsionImpedance();
+        f0_ = params.fundamental();
+        w0_ = 2.0 * std::numbers::pi * f0_ / fs_;
+        fLossProbe_ = std::min(5.0 * f0_, 0.4 * fs_);
+        wLossProbe_ = 2.0 * std::numbers::pi * fLossProbe_ / fs_;
+        const double period = fs_ / f0_;
+        for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_})
+            line->prepare(period + 16.0);
+        designDispersion();
+        beta_ = -1.0;
+        setBeta(0.0899);
+        reset();
+    }
+
+    void reset() noexcept
+    {
+        for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_})
+            line->reset();
+        for (auto* f : {&lossBridge_, &lossFinger_, &lossTorsionBridge_, &lossTorsionFinger_}) f->reset();
+        dispersion_.reset();
+        u1In_ = u2In_ = u1tIn_ = u2tIn_ = T(0);
+        bridgeForce_ = T(0);
+    }
+
+    /// [audio thread] Moves the bow point. Cheap closed-form redesign; skipped when unchanged.
+    void setBeta(double beta) noexcept
+    {
+        if (!std::isfinite(beta)) return;
+        beta = std::clamp(beta, config::minBeta, config::maxBeta);
+        if (beta == beta_) return;
+        beta_ = beta;
+        const double c = params_.waveSpeed();
+        const double L = params_.length;
+        const double tau1 = 2.0 * beta * L / c, tau2 = 2.0 * (1.0 - beta) * L / c;
+        designLoss(lossBridge_, tau1, false);
+        designLoss(lossFinger_, tau2, false);
+        delayBridgeOut_ = 0.5 * tau1 * fs_;
+        delayBridgeBack_ = 0.5 * tau1 * fs_ - lossBridge_.phaseDelay(w0_);
+        delayFinger_ = tau2 * fs_ - lossFinger_.phaseDelay(w0_) - dispersion_.phaseDelay(w0_);
+        const double ct = c * params_.torsionSpeedRatio;
+        const double tau1t = 2.0 * beta * L / ct, tau2t = 2.0 * (1.0 - beta) * L / ct;
+        designLoss(lossTorsionBridge_, tau1t, true);
+        designLoss(lossTorsionFinger_, tau2t, true);
+        delayTorsionBridge_ = tau1t * fs_ - lossTorsionBridge_.phaseDelay(w0_);
+        delayTorsionFinger_ = tau2t * fs_ - lossTorsionFinger_.phaseDelay(w0_);
+    }
+
+    /// [audio thread] Reads the incoming waves of this sample; returns v_h (PHYSICS.md 1.3).
+    T beginSample() noexcept
+    {
+        const T arriving = bridgeOut_.read(delayBridgeOut_);
+        const T reflected = -lossBridge_.process(arriving);
+        bridgeForce_ = static_cast<T>(z0_) * (arriving - reflected);
+        u1In_ = bridgeBack_.read(delayBridgeBack_);
+        bridgeBack_.write(reflected);
+        u2In_ = -lossFinger_.process(dispersion_.process(fingerSide_.read(delayFinger_)));
+        if (options_.torsion) {
+            u1tIn_ = -lossTorsionBridge_.process(torsionBridge_.read(delayTorsionBridge_));
+            u2tIn_ = -lossTorsionFinger_.process(torsionFinger_.read(delayTorsionFinger_));
+        }
+        return u1In_ + u2In_ + u1tIn_ + u2tIn_;
+    }
+
+    /// [audio thread] Launches the outgoing waves for friction force f (bow on string).
+    void endSample(T f) noexcept
+    {
+        const T dv = f / static_cast<T>(2.0 * z0_);
+        bridgeOut_.write(u2In_ + dv);
+        fingerSide_.write(u1In_ + dv);
+        if (options_.torsion) {
+            const T dvt = f / static_cast<T>(2.0 * zt_);
+            torsionBridge_.write(u2tIn_ + dvt);
+            torsionFinger_.write(u1tIn_ + dvt);
+        }
+    }
+
+    /// Force of the string on the bridge for the current sample (valid after beginSample).
+    T bridgeForce() const noexcept { return bridgeForce_; }
+    /// Transverse part of the history velocity (what the bow would see with torsion ignored).
+    T transverseHistory() const noexcept { return u1In_ + u2In_; }
+
+    /// Impedance the bow sees: 1/Zeff = 1/Z0 + 1/Zt (torsion only lowers the load-line slope).
+    double effectiveImpedance() const noexcept
+    {
+        return options_.torsion ? 1.0 / (1.0 / z0_ + 1.0 / zt_) : z0_;
+    }
+    double impedance() const noexcept { return z0_; }
+    double fundamental() const noexcept { return f0_; }
+    double sampleRate() const noexcept { return fs_; }
+    double beta() const noexcept { return beta_; }
+    const StringParams& params() const noexcept { return params_; }
+    const WaveguideOptions& options() const noexcept { return options_; }
+
+    /// Total wave energy held in the lines (J): each stored sample of a travelling wave u on a
+    /// line of impedance Z carries Z u^2 / fs. Exact for integer delays and lossless ends.
+    double waveEnergy() const noexcept
+    {
+        const double h = 1.0 / fs_;
+        auto count = [](double d) { return static_cast<std::size_t>(std::ceil(d - 1e-9)); };
+        double e = z0_ * (bridgeOut_.sumOfSquares(count(delayBridgeOut_))
+                          + bridgeBack_.sumOfSquares(count(delayBridgeBack_))
+                          + fingerSide_.sumOfSquares(count(delayFinger_)));
+        if (options_.torsion)
+            e += zt_ * (torsionBridge_.sumOfSquares(count(delayTorsionBridge_))
+                        + torsionFinger_.sumOfSquares(count(delayTorsionFinger_)));
+        return e * h;
+    }
+
+    /// Delays (samples) currently used, for tests and diagnostics.
+    double bridgeRoundTripDelay() const noexcept { return delayBridgeOut_ + delayBridgeBack_; }
+    double fingerRoundTripDelay() const noexcept { return delayFinger_; }
+
+private:
+    void designLoss(OnePoleLoss<T>& filter, double tau, bool torsional) noexcept
+    {
+        if (!options_.losses) { filter.setIdentity(); return; }
+        const double etaLow = torsional ? 1.0 / params_.qTorsion
+                                        : lossFactor(f0_, f0_, params_.qLow, params_.qHigh, params_.qHighFrequency);
+        const double etaHigh = torsional ? 1.0 / params_.qTorsion
+                                         : lossFactor(fLossProbe_, f0_, params_.qLow, params_.qHigh, params_.qHighFrequency);
+        filter.design(segmentMagnitude(f0_, tau, etaLow), w0_, segmentMagnitude(fLossProbe_, tau, etaHigh), wLossProbe_);
+    }
+
+    /// Fits the allpass coefficient so the partials follow a stiff string, f_n / f_1 =
+    /// n sqrt((1 + B n^2) / (1 + B)), with the fundamental kept at f0.
+    void designDispersion()
+    {
+        dispersion_.sections = 0;
+        dispersion_.a = T(0);
+        const double B = params_.inharmonicity;
+        if (!options_.dispersion || B <= 0.0) return;
+        const int K = std::clamp(options_.dispersionSections, 1, 8);
+        const double period = fs_ / f0_;
+        // First-order sections cannot follow the law up to high partials; fit the first 16 (below
+        // 5 kHz), weighted towards the low ones whose tuning the ear follows most closely.
+        const int nMax = std::clamp(static_cast<int>(std::min(0.25 * fs_, 5000.0) / f0_), 2, 16);
+        double bestA = 0.0, bestErr = 1e300;
+        for (int step = 1; step < 400; ++step) {
+            const double a = -0.995 * step / 400.0;
+            const double bulk = period - K * DispersionChain<T>::sectionPhaseDelay(a, w0_);
+            if (bulk < 2.0) break;
+            double err = 0.0;
+            for (int n = 2; n <= nMax; ++n) {
+                const double target = n * f0_ * std::sqrt((1.0 + B * n * n) / (1.0 + B));
+                // loop delay at the target frequency -> frequency this partial actually takes
+                const double w = 2.0 * std::numbers::pi * target / fs_;
+                const double loop = bulk + K * DispersionChain<T>::sectionPhaseDelay(a, w);
+                const double got = n * fs_ / loop;
+                err += std::pow(std::log(got / target), 2.0) / n;
+            }
+            if (err < bestErr) { bestErr = err; bestA = a; }
+        }
+        dispersion_.sections = K;
+        dispersion_.a = static_cast<T>(bestA);
+    }
+
+    double fs_ = 48000.0, f0_ = 146.83, w0_ = 0.0, fLossProbe_ = 0.0, wLossProbe_ = 0.0;
+    double z0_ = 0.5, zt_ = 1.0, beta_ = -1.0;
+    StringParams params_;
+    WaveguideOptions options_;
+    DelayLine<T> bridgeOut_, bridgeBack_, fingerSide_, torsionBridge_, torsionFinger_;
+    OnePoleLoss<T> lossBridge_, lossFinger_, lossTorsionBridge_, lossTorsionFinger_;
+    DispersionChain<T> dispersion_;
+    double delayBridgeOut_ = 1, delayBridgeBack_ = 1, delayFinger_ = 1, delayTorsionBridge_ = 1, delayTorsionFinger_ = 1;
+    T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0);
+};
+
+} // namespace rosin::dsp

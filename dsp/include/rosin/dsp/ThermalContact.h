@@ -1,0 +1,172 @@
+// Heat balance of the rosin contact (PHYSICS.md 3.3-3.4).
+//
+// Conduction into a half-space is sqrt(s) in the Laplace domain (sqrt(s + kappa) when the
+// surface moves through the contact and is renewed). Both are written as a sum of one-pole
+// states on a logarithmic grid of rates xi_k, so the history costs O(M) per sample instead of
+// a growing convolution. Conduction is stiff at audio rates, so the temperature is updated
+// implicitly with the pole states integrated exactly over the step.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "Config.h"
+#include "FrictionLaws.h"
+
+namespace rosin::dsp {
+
+/// Bank of one-pole states approximating sqrt(s + kappa) for one side of the contact.
+/// Flux per unit area and effusivity, with theta held over the step: Gamma*theta - H.
+template <typename T>
+class ConductionBank {
+public:
+    /// [setup thread] Log grid xi_min..xi_max, `perDecade` poles per decade. Weights from the
+    /// trapezoid rule on sqrt(s) = (1/pi) int s/(s+xi) xi^{-1/2} dxi, plus the two ends of the
+    /// integral the grid leaves out: below it, one pole at xi_lo/3 (matters for t ~ 1/xi_min);
+    /// above it, s/(s+xi) ~ s/xi, i.e. an extra heat capacity 2/(pi sqrt(xi_hi)) (matters once
+    /// kappa approaches xi_max).
+    void prepare(double sampleRate, double xiMin, double xiMax, double perDecade) noexcept
+    {
+        h_ = 1.0 / sampleRate;
+        const double decades = std::log10(xiMax / xiMin);
+        count_ = std::clamp(static_cast<int>(std::ceil(decades * perDecade)) + 1, 2, config::maxThermalPoles - 1);
+        const double delta = std::log(xiMax / xiMin) / (count_ - 1);
+        for (int k = 0; k < count_; ++k) {
+            xi_[k] = xiMin * std::exp(delta * k);
+            weight_[k] = std::sqrt(xi_[k]) * delta / std::numbers::pi;
+        }
+        // int_0^{xi_lo} xi^{-1/2} dxi / pi with xi_lo the lower edge of the first cell.
+        const double xiLo = xiMin * std::exp(-0.5 * delta);
+        xi_[count_] = xiLo / 3.0;
+        weight_[count_] = 2.0 * std::sqrt(xiLo) / std::numbers::pi;
+        ++count_;
+        tailCapacity_ = 2.0 / (std::numbers::pi * std::sqrt(xiMax * std::exp(0.5 * delta)));
+        for (int k = 0; k < count_; ++k) baseDecay_[k] = std::exp(-xi_[k] * h_);
+        kappa_ = -1.0;
+        setKappa(0.0);
+        reset();
+    }
+
+    void reset() noexcept { z_.fill(T(0)); thetaPrev_ = 0.0; }
+
+    /// [audio thread] Surface-renewal rate (1/s). Coefficients are recomputed only when it moves
+    /// by more than 2 % (or to/from zero), which during sticking is never.
+    void setKappa(double kappa) noexcept
+    {
+        if (kappa == kappa_) return;
+        if (kappa > 0.0 && kappa_ > 0.0 && std::abs(kappa - kappa_) < 0.02 * kappa_) return;
+        kappa_ = kappa;
+        const double ek = std::exp(-kappa * h_);
+        double gamma = 0.0;
+        for (int k = 0; k < count_; ++k) {
+            const double eps = baseDecay_[k] * ek;
+            const double b = (1.0 - eps) / (xi_[k] + kappa);
+            decay_[k] = static_cast<T>(eps);
+            gain_[k] = static_cast<T>(b);
+            historyWeight_[k] = static_cast<T>(weight_[k] * xi_[k] * eps);
+            gamma += weight_[k] * (1.0 - xi_[k] * b);
+        }
+        gamma_ = gamma;
+    }
+
+    /// This step's flux (per unit area and effusivity) is gamma() * theta_new - history().
+    double gamma() const noexcept { return gamma_ + tailCapacity_ * (1.0 / h_ + kappa_); }
+
+    /// History part of this step's flux (depends on past states only).
+    double history() const noexcept
+    {
+        T s = T(0);
+        for (int k = 0; k < count_; ++k) s += historyWeight_[k] * z_[k];
+        return static_cast<double>(s) + tailCapacity_ * thetaPrev_ / h_;
+    }
+
+    /// Commit the step with the new temperature.
+    void advance(T theta) noexcept
+    {
+        for (int k = 0; k < count_; ++k) z_[k] = decay_[k] * z_[k] + gain_[k] * theta;
+        thetaPrev_ = static_cast<double>(theta);
+    }
+
+    /// Flux (per unit area and effusivity) if the temperature is held at theta from now on
+    /// (the capacity term then contributes only its kappa part).
+    double flux(double theta) const noexcept
+    {
+        double s = tailCapacity_ * kappa_ * theta;
+        for (int k = 0; k < count_; ++k) s += weight_[k] * (theta - xi_[k] * static_cast<double>(z_[k]));
+        return s;
+    }
+
+    int poleCount() const noexcept { return count_; }
+
+private:
+    static constexpr int N = config::maxThermalPoles;
+    double h_ = 1.0 / 48000.0, kappa_ = -1.0, gamma_ = 0.0, tailCapacity_ = 0.0, thetaPrev_ = 0.0;
+    int count_ = 0;
+    std::array<double, N> xi_{}, weight_{}, baseDecay_{};
+    alignas(32) std::array<T, N> z_{}, decay_{}, gain_{}, historyWeight_{};
+};
+
+/// Contact temperature rise theta (K above ambient) driven by frictional heating.
+template <typename T>
+class ThermalContact {
+public:
+    /// [setup thread]
+    void prepare(double sampleRate, const ThermalParams& params) noexcept
+    {
+        params_ = params;
+        h_ = 1.0 / sampleRate;
+        const double xiMax = params.xiMaxOverSampleRate * sampleRate;
+        stringSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade);
+        rodSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade);
+        reset();
+    }
+
+    void reset() noexcept
+    {
+        stringSide_.reset();
+        rodSide_.reset();
+        theta_ = 0.0;
+    }
+
+    /// [audio thread] One implicit step (PHYSICS.md 3.4). heat = |f dv| and slidingSpeed = |dv|
+    /// of the previous step; area (m^2) from the contact law. heatSlope = d(heat)/d(theta) at
+    /// that state (<= 0 while slipping: friction falls as the contact warms). Taking the heat
+    /// input implicitly to first order keeps the update stable where mu(theta) is steep; the
+    /// explicit form oscillates there once the step is long against the layer's storage time.
+    /// Returns the new theta.
+    double step(double heat, double slidingSpeed, double area, double heatSlope = 0.0) noexcept
+    {
+        if (!(area > 0.0)) {
+            // Bow off the string: no contact, the rosin spot relaxes to ambient.
+            theta_ = 0.0;
+            stringSide_.advance(T(0));
+            rodSide_.setKappa(0.0);
+            rodSide_.advance(T(0));
+            return theta_;
+        }
+        const double radius = std::sqrt(area / std::numbers::pi);
+        const double rhoCDelta = params_.rosinHeatCapacity * params_.layerThickness;
+        const double storage = rhoCDelta * area / h_;
+        const double advection = rhoCDelta * params_.advectionWidthFactor * radius * slidingSpeed;
+        rodSide_.setKappa(3.0 * slidingSpeed / (8.0 * radius));
+        const double es = area * params_.stringEffusivity, er = area * params_.rodEffusivity;
+        const double slope = std::min(heatSlope, 0.0);
+        const double num = storage * theta_ + heat - slope * theta_ + es * stringSide_.history() + er * rodSide_.history();
+        const double den = storage + advection - slope + es * stringSide_.gamma() + er * rodSide_.gamma();
+        theta_ = std::max(0.0, num / den);
+        stringSide_.advance(static_cast<T>(theta_));
+        rodSide_.advance(static_cast<T>(theta_));
+        return theta_;
+    }
+
+    double temperature() const noexcept { return theta_; }
+    const ThermalParams& params() const noexcept { return params_; }
+
+private:
+    ThermalParams params_;
+    double h_ = 1.0 / 48000.0, theta_ = 0.0;
+    ConductionBank<T> stringSide_, rodSide_;
+};
+
+} // namespace rosin::dsp

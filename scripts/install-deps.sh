@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The one list of Debian 12 packages Rosin needs. README and .ci/run both call this script.
+# Run as root on a fresh Debian 12 machine; it is idempotent and quick when all is installed.
+set -euo pipefail
+
+# Core build + dsp/lab + tests + benchmarks (always needed).
+CORE_PKGS=(
+  build-essential cmake ninja-build pkg-config git
+  libsndfile1-dev libcli11-dev nlohmann-json3-dev libeigen3-dev libpng-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev
+)
+
+missing=()
+for p in "${CORE_PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  echo "[install-deps] all ${#CORE_PKGS[@]} packages present" >&2
+  exit 0
+fi
+if [[ $(id -u) -ne 0 ]]; then
+  echo "[install-deps] missing packages: ${missing[*]} (run as root, or install them yourself)" >&2
+  exit 1
+fi
+echo "[install-deps] installing: ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}"
