@@ -48,6 +48,7 @@ public:
         if (params.model == FrictionModel::Thermal) law_.build(params.fit, std::nullopt, params.thermal);
         if (params.model == FrictionModel::Enhanced) law_.build(params.fit, params.speedFunction, params.thermal);
         thermal_.prepare(sampleRate, params.thermal);
+        muAtRest_ = speedLaw(0.0).mu;
         reset();
     }
 
@@ -67,7 +68,11 @@ public:
     {
         const double vh = finiteOr(vhIn), vb = std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed);
         const double fb = std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce);
-        const double load = area_.effectiveLoad(fb);
+        if (fb != forceCached_) { // pow() for the power law: only when the force moves
+            forceCached_ = fb;
+            loadCached_ = area_.effectiveLoad(fb);
+        }
+        const double load = loadCached_;
         const double twoZ = 2.0 * zEff;
         const double D = vb - vh;
         const double side = D >= 0.0 ? 1.0 : -1.0;
@@ -75,7 +80,7 @@ public:
 
         double theta = 0.0, f = 0.0;
         if (params_.model != FrictionModel::FrictionCurve)
-            theta = thermal_.step(heatPrev_, slidePrev_, area_.area(fb), heatSlopePrev_);
+            theta = thermal_.step(heatPrev_, slidePrev_, area_.areaPerNewton * load, heatSlopePrev_);
 
         if (params_.model == FrictionModel::Thermal) {
             const double limit = load * law_(theta);
@@ -131,7 +136,7 @@ private:
     /// the load line may cut it three times; the McIntyre-Woodhouse hysteresis rule picks one.
     double solveWithJumpRule(double D, double fStick, double load, double scale, double twoZ) noexcept
     {
-        const double muStatic = scale * speedLaw(0.0).mu;
+        const double muStatic = scale * muAtRest_;
         const bool canStick = std::abs(fStick) <= muStatic * load;
         const double side = D >= 0.0 ? 1.0 : -1.0;
         if (state_ == ContactState::Stick) {
@@ -198,6 +203,7 @@ private:
     ThermalContact<T> thermal_;
     ContactState state_ = ContactState::Stick;
     double xPrev_ = 0.0, heatPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePrev_ = 0.0;
+    double muAtRest_ = 1.0, forceCached_ = -1.0, loadCached_ = 0.0;
 };
 
 } // namespace rosin::dsp

@@ -18,6 +18,6 @@ inline constexpr double minSegmentDelay = 1.0;
 /// Number of entries of the temperature-law tables (mu(theta), y(theta)).
 inline constexpr int temperatureTableSize = 2048;
 /// Maximum number of poles per side in the thermal conduction bank.
-inline constexpr int maxThermalPoles = 32;
+inline constexpr int maxThermalPoles = 48;
 
 } // namespace rosin::dsp::config

@@ -26,11 +26,19 @@ public:
     /// Largest delay (samples) that read() accepts.
     double capacity() const noexcept { return static_cast<double>(buffer_.size()) - 5.0; }
 
-    /// Value written `delay` samples ago, where delay = 1 is the most recent write.
-    /// Read before this sample's write. Third-order Lagrange interpolation (exact at
-    /// integer delays, FIR so it stays smooth when the delay moves every sample);
-    /// linear between 1 and 2 samples where the Lagrange stencil would need the future.
-    T read(double delay) const noexcept
+    /// Read position and interpolation weights for one delay. Computing them is the costly
+    /// part of a fractional read, and delays change only when the bow moves, so callers keep
+    /// a Tap and refresh it then.
+    struct Tap {
+        std::size_t base = 1; ///< delay of the first stencil point
+        T h0 = T(1), h1 = T(0), h2 = T(0), h3 = T(0);
+    };
+
+    /// Tap for `delay` samples, where delay = 1 is the most recent write (read before this
+    /// sample's write). Third-order Lagrange (exact at integer delays, FIR so it stays smooth
+    /// when the delay moves every sample); linear between 1 and 2 samples, where the Lagrange
+    /// stencil would need the future.
+    Tap tap(double delay) const noexcept
     {
         delay = std::clamp(delay, config::minSegmentDelay, capacity());
         double whole = std::floor(delay);
@@ -41,19 +49,32 @@ public:
         if (fraction < 1e-9) fraction = 0.0;
         const auto n = static_cast<std::size_t>(whole);
         const T frac = static_cast<T>(fraction);
+        Tap t;
         if (n < 2) {
-            const T a = at(1), b = at(2);
-            return a + frac * (b - a);
+            t.base = 1; // linear between delays 1 and 2 (n == 1 here)
+            t.h0 = T(1) - frac;
+            t.h1 = frac;
+            t.h2 = t.h3 = T(0);
+            return t;
         }
         // Stencil at delays n-1, n, n+1, n+2, evaluated at x = 1 + frac.
         const T x = T(1) + frac;
         const T x0 = x, x1 = x - T(1), x2 = x - T(2), x3 = x - T(3);
-        const T h0 = -x1 * x2 * x3 / T(6);
-        const T h1 = x0 * x2 * x3 / T(2);
-        const T h2 = -x0 * x1 * x3 / T(2);
-        const T h3 = x0 * x1 * x2 / T(6);
-        return h0 * at(n - 1) + h1 * at(n) + h2 * at(n + 1) + h3 * at(n + 2);
+        t.base = n - 1;
+        t.h0 = -x1 * x2 * x3 / T(6);
+        t.h1 = x0 * x2 * x3 / T(2);
+        t.h2 = -x0 * x1 * x3 / T(2);
+        t.h3 = x0 * x1 * x2 / T(6);
+        return t;
     }
+
+    T read(const Tap& t) const noexcept
+    {
+        return t.h0 * at(t.base) + t.h1 * at(t.base + 1) + t.h2 * at(t.base + 2) + t.h3 * at(t.base + 3);
+    }
+
+    /// Convenience for tests and setup code: tap and read in one.
+    T read(double delay) const noexcept { return read(tap(delay)); }
 
     void write(T value) noexcept
     {

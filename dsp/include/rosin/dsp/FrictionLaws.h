@@ -62,9 +62,9 @@ struct ThermalParams {
     double referenceAmbientCelsius = 20.0;///< ambient of the steady-sliding measurement
     double glassTransitionCelsius = 49.0; ///< rosin of this preset
     double referenceGlassTransitionCelsius = 49.0; ///< violin rosin of the measurement [seed]
-    double polesPerDecade = 2.0;          ///< conduction bank density
+    double polesPerDecade = 1.5;          ///< conduction bank density (errors < 1 %)
     double xiMin = 0.3;                   ///< lowest pole (1/s)              [PHYSICS.md 3.4]
-    double xiMaxOverSampleRate = 30.0;    ///< highest pole / fs
+    double xiMaxOverSampleRate = 10.0;    ///< highest pole / fs (above: a capacity term)
 
     /// Temperature offset added to the contact rise before looking up the friction law:
     /// a warmer room, or a softer rosin (lower Tg), both act like a hotter contact.

@@ -81,20 +81,25 @@ public:
         designLoss(lossTorsionFinger_, tau2t, true);
         delayTorsionBridge_ = tau1t * fs_ - lossTorsionBridge_.phaseDelay(w0_);
         delayTorsionFinger_ = tau2t * fs_ - lossTorsionFinger_.phaseDelay(w0_);
+        tapBridgeOut_ = bridgeOut_.tap(delayBridgeOut_);
+        tapBridgeBack_ = bridgeBack_.tap(delayBridgeBack_);
+        tapFinger_ = fingerSide_.tap(delayFinger_);
+        tapTorsionBridge_ = torsionBridge_.tap(delayTorsionBridge_);
+        tapTorsionFinger_ = torsionFinger_.tap(delayTorsionFinger_);
     }
 
     /// [audio thread] Reads the incoming waves of this sample; returns v_h (PHYSICS.md 1.3).
     T beginSample() noexcept
     {
-        const T arriving = bridgeOut_.read(delayBridgeOut_);
+        const T arriving = bridgeOut_.read(tapBridgeOut_);
         const T reflected = -lossBridge_.process(arriving);
         bridgeForce_ = static_cast<T>(z0_) * (arriving - reflected);
-        u1In_ = bridgeBack_.read(delayBridgeBack_);
+        u1In_ = bridgeBack_.read(tapBridgeBack_);
         bridgeBack_.write(reflected);
-        u2In_ = -lossFinger_.process(dispersion_.process(fingerSide_.read(delayFinger_)));
+        u2In_ = -lossFinger_.process(dispersion_.process(fingerSide_.read(tapFinger_)));
         if (options_.torsion) {
-            u1tIn_ = -lossTorsionBridge_.process(torsionBridge_.read(delayTorsionBridge_));
-            u2tIn_ = -lossTorsionFinger_.process(torsionFinger_.read(delayTorsionFinger_));
+            u1tIn_ = -lossTorsionBridge_.process(torsionBridge_.read(tapTorsionBridge_));
+            u2tIn_ = -lossTorsionFinger_.process(torsionFinger_.read(tapTorsionFinger_));
         }
         return u1In_ + u2In_ + u1tIn_ + u2tIn_;
     }
@@ -200,6 +205,7 @@ private:
     OnePoleLoss<T> lossBridge_, lossFinger_, lossTorsionBridge_, lossTorsionFinger_;
     DispersionChain<T> dispersion_;
     double delayBridgeOut_ = 1, delayBridgeBack_ = 1, delayFinger_ = 1, delayTorsionBridge_ = 1, delayTorsionFinger_ = 1;
+    typename DelayLine<T>::Tap tapBridgeOut_, tapBridgeBack_, tapFinger_, tapTorsionBridge_, tapTorsionFinger_;
     T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0);
 };
 

@@ -30,7 +30,7 @@ public:
     {
         h_ = 1.0 / sampleRate;
         const double decades = std::log10(xiMax / xiMin);
-        count_ = std::clamp(static_cast<int>(std::ceil(decades * perDecade)) + 1, 2, config::maxThermalPoles - 1);
+        count_ = std::clamp(static_cast<int>(std::ceil(decades * perDecade)) + 1, 2, config::maxThermalPoles - kBlock);
         const double delta = std::log(xiMax / xiMin) / (count_ - 1);
         for (int k = 0; k < count_; ++k) {
             xi_[k] = xiMin * std::exp(delta * k);
@@ -42,7 +42,17 @@ public:
         weight_[count_] = 2.0 * std::sqrt(xiLo) / std::numbers::pi;
         ++count_;
         tailCapacity_ = 2.0 / (std::numbers::pi * std::sqrt(xiMax * std::exp(0.5 * delta)));
+        tailRate_ = tailCapacity_ / h_;
         for (int k = 0; k < count_; ++k) baseDecay_[k] = std::exp(-xi_[k] * h_);
+        // Pad to whole blocks with inert poles (zero weight) so the hot loops vectorise.
+        padded_ = (count_ + kBlock - 1) / kBlock * kBlock;
+        for (int k = count_; k < padded_; ++k) { xi_[k] = 1.0; weight_[k] = 0.0; baseDecay_[k] = 0.0; }
+        for (int k = 0; k < padded_; ++k) {
+            xiT_[k] = static_cast<T>(xi_[k]);
+            weightT_[k] = static_cast<T>(weight_[k]);
+            weightXiT_[k] = static_cast<T>(weight_[k] * xi_[k]);
+            baseDecayT_[k] = static_cast<T>(baseDecay_[k]);
+        }
         kappa_ = -1.0;
         setKappa(0.0);
         reset();
@@ -57,34 +67,44 @@ public:
         if (kappa == kappa_) return;
         if (kappa > 0.0 && kappa_ > 0.0 && std::abs(kappa - kappa_) < 0.02 * kappa_) return;
         kappa_ = kappa;
-        const double ek = std::exp(-kappa * h_);
-        double gamma = 0.0;
-        for (int k = 0; k < count_; ++k) {
-            const double eps = baseDecay_[k] * ek;
-            const double b = (1.0 - eps) / (xi_[k] + kappa);
-            decay_[k] = static_cast<T>(eps);
-            gain_[k] = static_cast<T>(b);
-            historyWeight_[k] = static_cast<T>(weight_[k] * xi_[k] * eps);
-            gamma += weight_[k] * (1.0 - xi_[k] * b);
+        // Runs on most slipping samples: kept in T and in whole blocks so it vectorises.
+        const T ek = static_cast<T>(std::exp(-kappa * h_)), kap = static_cast<T>(kappa);
+        std::array<T, kBlock> g{};
+        for (int k = 0; k < padded_; k += kBlock) {
+            for (int j = 0; j < kBlock; ++j) {
+                const T eps = baseDecayT_[k + j] * ek;
+                const T b = (T(1) - eps) / (xiT_[k + j] + kap);
+                decay_[k + j] = eps;
+                gain_[k + j] = b;
+                historyWeight_[k + j] = weightXiT_[k + j] * eps;
+                g[j] += weightT_[k + j] * (T(1) - xiT_[k + j] * b);
+            }
         }
+        double gamma = 0.0;
+        for (int j = 0; j < kBlock; ++j) gamma += static_cast<double>(g[j]);
         gamma_ = gamma;
+        gammaTotal_ = gamma + tailCapacity_ * (1.0 / h_ + kappa);
     }
 
     /// This step's flux (per unit area and effusivity) is gamma() * theta_new - history().
-    double gamma() const noexcept { return gamma_ + tailCapacity_ * (1.0 / h_ + kappa_); }
+    double gamma() const noexcept { return gammaTotal_; }
 
     /// History part of this step's flux (depends on past states only).
     double history() const noexcept
     {
+        std::array<T, kBlock> acc{};
+        for (int k = 0; k < padded_; k += kBlock)
+            for (int j = 0; j < kBlock; ++j) acc[j] += historyWeight_[k + j] * z_[k + j];
         T s = T(0);
-        for (int k = 0; k < count_; ++k) s += historyWeight_[k] * z_[k];
-        return static_cast<double>(s) + tailCapacity_ * thetaPrev_ / h_;
+        for (int j = 0; j < kBlock; ++j) s += acc[j];
+        return static_cast<double>(s) + tailRate_ * thetaPrev_;
     }
 
     /// Commit the step with the new temperature.
     void advance(T theta) noexcept
     {
-        for (int k = 0; k < count_; ++k) z_[k] = decay_[k] * z_[k] + gain_[k] * theta;
+        for (int k = 0; k < padded_; k += kBlock)
+            for (int j = 0; j < kBlock; ++j) z_[k + j] = decay_[k + j] * z_[k + j] + gain_[k + j] * theta;
         thetaPrev_ = static_cast<double>(theta);
     }
 
@@ -101,10 +121,13 @@ public:
 
 private:
     static constexpr int N = config::maxThermalPoles;
-    double h_ = 1.0 / 48000.0, kappa_ = -1.0, gamma_ = 0.0, tailCapacity_ = 0.0, thetaPrev_ = 0.0;
+    static constexpr int kBlock = 4; // one SSE register of floats
+    int padded_ = 0;
+    double h_ = 1.0 / 48000.0, kappa_ = -1.0, gamma_ = 0.0, gammaTotal_ = 0.0, tailCapacity_ = 0.0, tailRate_ = 0.0, thetaPrev_ = 0.0;
     int count_ = 0;
     std::array<double, N> xi_{}, weight_{}, baseDecay_{};
     alignas(32) std::array<T, N> z_{}, decay_{}, gain_{}, historyWeight_{};
+    alignas(32) std::array<T, N> xiT_{}, weightT_{}, weightXiT_{}, baseDecayT_{};
 };
 
 /// Contact temperature rise theta (K above ambient) driven by frictional heating.
@@ -116,6 +139,7 @@ public:
     {
         params_ = params;
         h_ = 1.0 / sampleRate;
+        rate_ = sampleRate;
         const double xiMax = params.xiMaxOverSampleRate * sampleRate;
         stringSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade);
         rodSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade);
@@ -145,16 +169,26 @@ public:
             rodSide_.advance(T(0));
             return theta_;
         }
-        const double radius = std::sqrt(area / std::numbers::pi);
+        if (area != areaCached_) {
+            areaCached_ = area;
+            radiusCached_ = std::sqrt(area / std::numbers::pi);
+        }
+        const double radius = radiusCached_;
         const double rhoCDelta = params_.rosinHeatCapacity * params_.layerThickness;
-        const double storage = rhoCDelta * area / h_;
+        const double storage = rhoCDelta * area * rate_;
         const double advection = rhoCDelta * params_.advectionWidthFactor * radius * slidingSpeed;
         rodSide_.setKappa(3.0 * slidingSpeed / (8.0 * radius));
         const double es = area * params_.stringEffusivity, er = area * params_.rodEffusivity;
         const double slope = std::min(heatSlope, 0.0);
         const double num = storage * theta_ + heat - slope * theta_ + es * stringSide_.history() + er * rodSide_.history();
+        // While sticking nothing in the denominator moves, so its reciprocal is reused: the
+        // division sits on the sample-to-sample dependency chain and is its slowest link.
         const double den = storage + advection - slope + es * stringSide_.gamma() + er * rodSide_.gamma();
-        theta_ = std::max(0.0, num / den);
+        if (den != denCached_) {
+            denCached_ = den;
+            invDenCached_ = 1.0 / den;
+        }
+        theta_ = std::max(0.0, num * invDenCached_);
         stringSide_.advance(static_cast<T>(theta_));
         rodSide_.advance(static_cast<T>(theta_));
         return theta_;
@@ -165,7 +199,7 @@ public:
 
 private:
     ThermalParams params_;
-    double h_ = 1.0 / 48000.0, theta_ = 0.0;
+    double h_ = 1.0 / 48000.0, rate_ = 48000.0, theta_ = 0.0, areaCached_ = -1.0, radiusCached_ = 0.0, denCached_ = 0.0, invDenCached_ = 0.0;
     ConductionBank<T> stringSide_, rodSide_;
 };
 

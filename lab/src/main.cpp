@@ -1,0 +1,291 @@
+// The `rosin` command: offline science on the bowed-string model.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <string>
+
+#include "rosin/dsp.h"
+#include "rosin/lab/Bench.h"
+#include "rosin/lab/Error.h"
+#include "rosin/lab/Gesture.h"
+#include "rosin/lab/Output.h"
+#include "rosin/lab/Presets.h"
+#include "rosin/lab/Render.h"
+
+namespace fs = std::filesystem;
+using namespace rosin;
+using namespace rosin::lab;
+
+namespace {
+
+/// CLI11's Range lets NaN through; every number we take must be finite and in range.
+CLI::Validator finiteIn(double lo, double hi)
+{
+    return CLI::Validator(
+        [lo, hi](std::string& s) -> std::string {
+            double x = 0.0;
+            try {
+                std::size_t used = 0;
+                x = std::stod(s, &used);
+                if (used != s.size()) return "'" + s + "' is not a number";
+            } catch (const std::exception&) {
+                return "'" + s + "' is not a number";
+            }
+            if (!std::isfinite(x) || x < lo || x > hi)
+                return "value " + s + " is outside " + std::to_string(lo) + ".." + std::to_string(hi);
+            return {};
+        },
+        "FLOAT in [" + CLI::detail::to_string(lo) + " - " + CLI::detail::to_string(hi) + "]");
+}
+
+/// Choices shared by every command that builds a model.
+struct ModelOptions {
+    std::string string = "cello-D";
+    std::string model = "thermal";
+    std::string fit = "auto";
+    std::string speedFunction = "rod";
+    std::string contact = "amontons";
+    double contactExponent = 2.0 / 3.0;
+    std::string rosin = "violin";
+    double ambient = 20.0;
+    double footprint = 1.0;
+    bool noTorsion = false, noLosses = false, dispersion = false;
+    std::string presets;
+
+    void add(CLI::App* app)
+    {
+        app->add_option("--string", string, "String preset id (see `rosin strings`), or FILE.json:NAME")
+            ->capture_default_str();
+        app->add_option("--model", model, "Friction model: friction-curve (mu of sliding speed), thermal (mu of "
+                                          "contact temperature), enhanced (temperature and speed)")
+            ->check(CLI::IsMember({"friction-curve", "thermal", "enhanced"}))
+            ->capture_default_str();
+        app->add_option("--fit", fit, "Steady-sliding fit the laws are built from: sw (Smith & Woodhouse "
+                                      "exponentials), wg (Woodhouse & Galluzzo power law); auto = wg for "
+                                      "the enhanced model, sw otherwise")
+            ->check(CLI::IsMember({"auto", "sw", "wg"}))
+            ->capture_default_str();
+        app->add_option("--speed-function", speedFunction, "Enhanced model only: speed function of a rosined rod or of a real bow")
+            ->check(CLI::IsMember({"rod", "bow"}))
+            ->capture_default_str();
+        app->add_option("--contact", contact, "Contact-area law: amontons (area ~ force, a bow's many "
+                                              "hairs), hertz (area ~ force^(2/3), a smooth rod), power "
+                                              "(area ~ force^n, n from --contact-exponent)")
+            ->check(CLI::IsMember({"amontons", "hertz", "power"}))
+            ->capture_default_str();
+        app->add_option("--contact-exponent", contactExponent, "Exponent n for --contact power")
+            ->check(finiteIn(0.1, 2.0));
+        app->add_option("--rosin", rosin, "Rosin preset (violin: Tg 49 C, bass: Tg 16 C) or a rosin JSON file")
+            ->capture_default_str();
+        app->add_option("--ambient", ambient, "Ambient temperature (C)")->check(finiteIn(-30.0, 60.0))->capture_default_str();
+        app->add_option("--footprint", footprint, "Footprint ratio r_A: contact area per newton relative to "
+                                                  "the steady-sliding test (thermal models)")
+            ->check(finiteIn(0.05, 20.0))
+            ->capture_default_str();
+        app->add_flag("--no-torsion", noTorsion, "Leave out torsional waves");
+        app->add_flag("--no-losses", noLosses, "Lossless string (ideal rigid ends)");
+        app->add_flag("--dispersion", dispersion, "Bending-stiffness dispersion from the string's inharmonicity B");
+        app->add_option("--presets", presets, "Presets directory (default: $ROSIN_PRESETS or the source tree's presets/)");
+    }
+
+    dsp::BowedStringConfig build() const
+    {
+        const fs::path dir = presetDirectory(presets);
+        dsp::BowedStringConfig c;
+        c.string = findString(dir, string).params;
+        const std::map<std::string, dsp::FrictionModel> models{{"friction-curve", dsp::FrictionModel::FrictionCurve},
+                                                               {"thermal", dsp::FrictionModel::Thermal},
+                                                               {"enhanced", dsp::FrictionModel::Enhanced}};
+        c.friction.model = models.at(model);
+        const std::string f = fit == "auto" ? (model == "enhanced" ? "wg" : "sw") : fit;
+        c.friction.fit = f == "wg" ? dsp::SteadyFit::WoodhouseGalluzzo : dsp::SteadyFit::SmithWoodhouse;
+        c.friction.speedFunction = speedFunction == "bow" ? dsp::SpeedFunction::Bow : dsp::SpeedFunction::Rod;
+        c.friction.contactLaw = contact == "amontons" ? dsp::ContactLaw::Amontons : dsp::ContactLaw::PowerLaw;
+        c.friction.contactExponent = contact == "hertz" ? 2.0 / 3.0 : contactExponent;
+        c.friction.thermal.glassTransitionCelsius = findRosin(dir, rosin).glassTransitionCelsius;
+        c.friction.thermal.ambientCelsius = ambient;
+        c.friction.thermal.footprintRatio = footprint;
+        c.waveguide.torsion = !noTorsion;
+        c.waveguide.losses = !noLosses;
+        c.waveguide.dispersion = dispersion;
+        return c;
+    }
+};
+
+int runRender(const ModelOptions& m, const std::string& gestureName, const Gesture& g0, const std::string& gestureFile,
+              double duration, double sampleRate, const std::string& out, bool noCsv, bool listen, bool quiet)
+{
+    RenderSpec spec;
+    spec.config = m.build();
+    spec.gesture = g0;
+    spec.gesture.kind = gestureFile.empty() ? parseGestureKind(gestureName) : GestureKind::File;
+    if (spec.gesture.kind == GestureKind::File) {
+        if (gestureFile.empty()) throw LabError("--gesture file needs --gesture-file FILE");
+        spec.gesture.rows = loadGestureFile(gestureFile);
+    }
+    spec.sampleRate = sampleRate;
+    spec.duration = duration > 0 ? duration : (spec.gesture.kind == GestureKind::File ? spec.gesture.naturalDuration() : 0.3);
+
+    OutputSet outputs;
+    const fs::path wavPath = out + ".wav", csvPath = out + ".csv";
+    const fs::path wavTmp = outputs.add(wavPath);
+    const fs::path csvTmp = noCsv ? fs::path() : outputs.add(csvPath);
+
+    Progress progress("rendering", !quiet);
+    const RenderResult result = render(spec, [&](double x) { progress.update(x); });
+    progress.finish();
+
+    std::vector<double> bridge(result.frames.size());
+    for (std::size_t i = 0; i < bridge.size(); ++i) bridge[i] = result.frames[i].bridgeForce;
+    writeWav(wavTmp, bridge, result.sampleRate, listen ? WavEncoding::Pcm24Normalized : WavEncoding::Float32);
+    if (!noCsv) writeRenderCsv(csvTmp, result);
+    outputs.commit();
+
+    if (!quiet) {
+        const RenderSummary s = summarise(result);
+        std::printf("string %s (f0 %.2f Hz, Z0 %.3f kg/s), model %s, %.0f Hz, %.3f s\n", spec.config.string.name.c_str(),
+                    spec.config.string.fundamental(), spec.config.string.impedance(), m.model.c_str(), spec.sampleRate,
+                    spec.duration);
+        if (s.firstSlipTime >= 0)
+            std::printf("first slip at %.2f ms (bridge force before it %.3f N)\n", 1e3 * s.firstSlipTime,
+                        s.bridgeForceBeforeSlip);
+        else
+            std::printf("the bow never slipped\n");
+        std::printf("peak bridge force %.3f N, peak contact rise %.1f K, slipping %.1f %% of the time\n",
+                    s.peakBridgeForce, s.peakTemperatureRise, 100.0 * s.slipFraction);
+        std::printf("wrote %s%s%s\n", wavPath.c_str(), noCsv ? "" : " and ", noCsv ? "" : csvPath.c_str());
+    }
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"rosin: bowed-string physics from rosin friction (Woodhouse, Euphonics 9.6).\n"
+                 "Simulates bow strokes on a string with a chosen friction model and writes what a\n"
+                 "researcher measures: the bridge force, and the bow-point velocity, friction force\n"
+                 "and contact temperature behind it. All quantities are SI units."};
+    app.require_subcommand(1);
+    app.footer("Examples:\n"
+               "  rosin render --force 1 --accel 1 --out stroke      Guettler stroke on the cello D\n"
+               "  rosin render --gesture-file presets/gestures/demo-phrase.csv --listen --out phrase\n"
+               "  rosin render --model enhanced --contact hertz --gesture constant --speed 0.1\n"
+               "  rosin strings                                      list the string presets\n"
+               "Run `rosin COMMAND --help` for each command's options.");
+
+    // ---- render
+    CLI::App* renderCmd = app.add_subcommand("render", "Simulate one bow gesture; write the bridge force as WAV and "
+                                                       "every simulated quantity as CSV");
+    renderCmd->footer(
+        "Gestures (PHYSICS.md 6.1):\n"
+        "  guettler   force F constant, speed a*t from rest (--force, --accel)\n"
+        "  constant   force F and speed v from t = 0 (--force, --speed)\n"
+        "  exp-speed  speed v (1 - exp(-t/tau)), force F (--speed, --time-constant, --force)\n"
+        "  exp-force  force F (1 - exp(-t/tau)), speed v (--force, --time-constant, --speed)\n"
+        "  file       rows time,force,speed,beta from --gesture-file, linear in between\n"
+        "Outputs: OUT.wav (bridge force in newtons as 32-bit float, or normalised 24-bit with\n"
+        "--listen) and OUT.csv (time_s, bridge_force_N, bow_point_velocity_m_s, friction_force_N,\n"
+        "contact_temperature_C, temperature_rise_K, stick, bow_force_N, bow_speed_m_s, beta).\n"
+        "Nothing is written unless the whole render succeeds.");
+    ModelOptions renderModel;
+    renderModel.add(renderCmd);
+    std::string gestureName = "guettler", gestureFile, out = "rosin-render";
+    Gesture gesture;
+    double duration = 0.0, sampleRate = 192000.0;
+    bool noCsv = false, listen = false, quiet = false;
+    renderCmd->add_option("--gesture", gestureName, "guettler, constant, exp-speed, exp-force or file")
+        ->check(CLI::IsMember({"guettler", "constant", "exp-speed", "exp-force", "file"}))
+        ->capture_default_str();
+    renderCmd->add_option("--gesture-file", gestureFile, "CSV of time,force,speed,beta rows (implies --gesture file)")
+        ->check(CLI::ExistingFile);
+    renderCmd->add_option("--force", gesture.force, "Bow force F (N)")->check(finiteIn(0.0, 20.0))->capture_default_str();
+    renderCmd->add_option("--accel", gesture.acceleration, "Bow acceleration a (m/s^2)")->check(finiteIn(-100.0, 100.0))->capture_default_str();
+    renderCmd->add_option("--speed", gesture.speed, "Bow speed v (m/s; negative = up bow)")->check(finiteIn(-10.0, 10.0))->capture_default_str();
+    renderCmd->add_option("--time-constant", gesture.timeConstant, "tau of the exponential gestures (s)")
+        ->check(finiteIn(1e-4, 10.0))
+        ->capture_default_str();
+    renderCmd->add_option("--beta", gesture.beta, "Bow position: distance from the bridge / string length")
+        ->check(finiteIn(dsp::config::minBeta, dsp::config::maxBeta))
+        ->capture_default_str();
+    renderCmd->add_option("--duration", duration, "Seconds to simulate (default: 0.3, or the gesture file's length)")
+        ->check(finiteIn(1e-3, 600.0));
+    renderCmd->add_option("--sample-rate", sampleRate, "Simulation rate (Hz); research default 192 kHz")
+        ->check(finiteIn(8000.0, 1.0e6))
+        ->capture_default_str();
+    renderCmd->add_option("-o,--out", out, "Output path prefix: writes OUT.wav and OUT.csv")->capture_default_str();
+    renderCmd->add_flag("--no-csv", noCsv, "Write only the WAV");
+    renderCmd->add_flag("--listen", listen, "Normalised 24-bit WAV for listening instead of newtons");
+    renderCmd->add_flag("-q,--quiet", quiet, "No progress and no summary");
+
+    // ---- strings
+    CLI::App* stringsCmd = app.add_subcommand("strings", "List the string presets with their physical constants");
+    std::string stringsPresets;
+    stringsCmd->add_option("--presets", stringsPresets, "Presets directory");
+
+    // ---- bench
+    CLI::App* benchCmd = app.add_subcommand("bench", "Time one held note (the shared/bench/peers protocol): prints "
+                                                     "RESULT name ns_per_sample rt_factor rms");
+    BenchOptions bench;
+    ModelOptions benchModel;
+    benchModel.string = "violin-A";
+    benchModel.add(benchCmd);
+    std::string precision = "float";
+    benchCmd->add_option("--seconds", bench.seconds, "Audio seconds per timed pass")->check(finiteIn(0.01, 3600.0))->capture_default_str();
+    benchCmd->add_option("--warmup", bench.warmup, "Untimed seconds before timing")->check(finiteIn(0.0, 60.0))->capture_default_str();
+    benchCmd->add_option("--sr", bench.sampleRate, "Sample rate (Hz)")->check(finiteIn(8000.0, 1.0e6))->capture_default_str();
+    benchCmd->add_option("--block", bench.block, "Block size")->check(CLI::Range(1, 65536))->capture_default_str();
+    benchCmd->add_option("--reps", bench.reps, "Timed passes (best is reported)")->check(CLI::Range(1, 1000))->capture_default_str();
+    benchCmd->add_option("--name", bench.name, "Name in the RESULT line")->capture_default_str();
+    benchCmd->add_option("--freq", bench.frequency, "Pitch of the held note (Hz): the string is stopped to it")
+        ->check(finiteIn(20.0, 4000.0))
+        ->capture_default_str();
+    benchCmd->add_option("--precision", precision, "float (plugin voice) or double (research)")
+        ->check(CLI::IsMember({"float", "double"}))
+        ->capture_default_str();
+
+    if (argc > 1 && argv[1][0] != '-') {
+        bool known = false;
+        for (const CLI::App* sub : app.get_subcommands({})) known |= sub->get_name() == argv[1];
+        if (!known) {
+            std::fprintf(stderr, "rosin: unknown command '%s' (render, strings, bench; see rosin --help)\n", argv[1]);
+            return 2;
+        }
+    }
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+
+    try {
+        if (*renderCmd)
+            return runRender(renderModel, gestureName, gesture, gestureFile, duration, sampleRate, out, noCsv, listen, quiet);
+        if (*stringsCmd) {
+            std::printf("%-16s %-5s %9s %7s %7s %9s %8s %8s\n", "id", "note", "f0 (Hz)", "L (m)", "T (N)", "m (g/m)",
+                        "Z0 (kg/s)", "c (m/s)");
+            for (const auto& p : loadAllStrings(presetDirectory(stringsPresets))) {
+                const auto& q = p.params;
+                std::printf("%-16s %-5s %9.2f %7.3f %7.1f %9.3f %8.3f %8.1f\n", p.id.c_str(), p.note.c_str(),
+                            q.fundamental(), q.length, q.tension, 1e3 * q.massPerLength, q.impedance(), q.waveSpeed());
+            }
+            return 0;
+        }
+        if (*benchCmd) {
+            bench.config = benchModel.build();
+            bench.useFloat = precision == "float";
+            return runBench(bench);
+        }
+    } catch (const LabError& e) {
+        std::fprintf(stderr, "rosin: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "rosin: unexpected error: %s\n", e.what());
+        return 3;
+    }
+    return 0;
+}
