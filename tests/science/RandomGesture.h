@@ -55,7 +55,8 @@ inline void randomGestureRun(double seconds, unsigned seed)
             // Friction is at most mu_s * 20 N (the force clamp); the bridge force of a string
             // that is driven that hard stays within a few times that.
             EXPECT_LT(peak, 200.0);
-            EXPECT_LT(hottest, 2000.0);
+            // Steady sliding at 10 N and 3 m/s settles near 260 K above ambient (PHYSICS.md 3.3).
+            EXPECT_LT(hottest, 500.0);
         }
     }
 }

@@ -57,9 +57,9 @@ public:
         thermal_.reset();
         state_ = ContactState::Stick;
         xPrev_ = 0.0;
-        heatPrev_ = 0.0;
+        heatPerLoadPrev_ = 0.0;
         slidePrev_ = 0.0;
-        heatSlopePrev_ = 0.0;
+        heatSlopePerLoadPrev_ = 0.0;
     }
 
     /// [audio thread] Solve this sample. vh: history velocity; vb: bow speed; fb: bow force;
@@ -80,7 +80,9 @@ public:
 
         double theta = 0.0, f = 0.0;
         if (params_.model != FrictionModel::FrictionCurve)
-            theta = thermal_.step(heatPrev_, slidePrev_, area_.areaPerNewton * load, heatSlopePrev_);
+            // Friction, and so the heat it makes, scales with the load: carried per unit load so a
+            // sudden drop in force does not pour the last sample's heat into a tiny footprint.
+            theta = thermal_.step(heatPerLoadPrev_ * load, slidePrev_, area_.areaPerNewton * load, heatSlopePerLoadPrev_ * load);
 
         if (params_.model == FrictionModel::Thermal) {
             const double limit = load * law_(theta);
@@ -92,13 +94,13 @@ public:
         }
         const double v = state_ == ContactState::Stick ? vb : vh + f / twoZ;
         const double dv = std::abs(v - vb);
-        heatPrev_ = std::abs(f) * dv;
+        heatPerLoadPrev_ = load > 0.0 ? std::abs(f) * dv / load : 0.0;
         slidePrev_ = dv;
-        // d(heat)/d(theta) at fixed sliding speed, for the semi-implicit thermal step.
-        heatSlopePrev_ = 0.0;
-        if (dv > 0.0 && params_.model == FrictionModel::Thermal) heatSlopePrev_ = load * dv * law_.slope(theta);
+        // d(heat)/d(theta) per unit load at fixed sliding speed, for the semi-implicit step.
+        heatSlopePerLoadPrev_ = 0.0;
+        if (dv > 0.0 && params_.model == FrictionModel::Thermal) heatSlopePerLoadPrev_ = dv * law_.slope(theta);
         if (dv > 0.0 && params_.model == FrictionModel::Enhanced)
-            heatSlopePrev_ = load * dv * speedFunction(params_.speedFunction, dv).mu * law_.slope(theta);
+            heatSlopePerLoadPrev_ = dv * speedFunction(params_.speedFunction, dv).mu * law_.slope(theta);
         return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), state_ == ContactState::Stick};
     }
 
@@ -202,7 +204,7 @@ private:
     TemperatureLaw law_;
     ThermalContact<T> thermal_;
     ContactState state_ = ContactState::Stick;
-    double xPrev_ = 0.0, heatPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePrev_ = 0.0;
+    double xPrev_ = 0.0, heatPerLoadPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePerLoadPrev_ = 0.0;
     double muAtRest_ = 1.0, forceCached_ = -1.0, loadCached_ = 0.0;
 };
 

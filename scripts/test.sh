@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Install, build and run every test except the `long` soak runs (run those with: ctest --test-dir build -L long).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+bash scripts/install-deps.sh
+bash scripts/build.sh
+ctest --test-dir build --output-on-failure -LE long -j "$(nproc)"
