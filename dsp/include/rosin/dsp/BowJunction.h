@@ -71,6 +71,11 @@ public:
         if (fb != forceCached_) { // pow() for the power law: only when the force moves
             forceCached_ = fb;
             loadCached_ = area_.effectiveLoad(fb);
+            invLoadCached_ = loadCached_ > 0.0 ? 1.0 / loadCached_ : 0.0;
+        }
+        if (zEff != zEffCached_) {
+            zEffCached_ = zEff;
+            invTwoZ_ = 0.5 / zEff;
         }
         const double load = loadCached_;
         const double twoZ = 2.0 * zEff;
@@ -92,9 +97,9 @@ public:
             const double scale = params_.model == FrictionModel::Enhanced ? law_(theta) : 1.0;
             f = solveWithJumpRule(D, fStick, load, scale, twoZ);
         }
-        const double v = state_ == ContactState::Stick ? vb : vh + f / twoZ;
+        const double v = state_ == ContactState::Stick ? vb : vh + f * invTwoZ_;
         const double dv = std::abs(v - vb);
-        heatPerLoadPrev_ = load > 0.0 ? std::abs(f) * dv / load : 0.0;
+        heatPerLoadPrev_ = std::abs(f) * dv * invLoadCached_;
         slidePrev_ = dv;
         // d(heat)/d(theta) per unit load at fixed sliding speed, for the semi-implicit step.
         heatSlopePerLoadPrev_ = 0.0;
@@ -205,7 +210,8 @@ private:
     ThermalContact<T> thermal_;
     ContactState state_ = ContactState::Stick;
     double xPrev_ = 0.0, heatPerLoadPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePerLoadPrev_ = 0.0;
-    double muAtRest_ = 1.0, forceCached_ = -1.0, loadCached_ = 0.0;
+    double muAtRest_ = 1.0, forceCached_ = -1.0, loadCached_ = 0.0, invLoadCached_ = 0.0;
+    double zEffCached_ = -1.0, invTwoZ_ = 0.0;
 };
 
 } // namespace rosin::dsp

@@ -55,13 +55,14 @@ public:
         }
         shift_ = tp.temperatureShift();
         scale_ = tp.footprintRatio;
+        invStep_ = 1.0 / step_;
     }
 
     /// Friction coefficient (or y) at contact rise theta above ambient, with the rosin and
     /// ambient shift and the footprint ratio applied. Clamped at both ends of the table.
     double operator()(double theta) const noexcept
     {
-        const double x = (theta + shift_) / step_;
+        const double x = (theta + shift_) * invStep_;
         if (!(x > 0.0)) return scale_ * table_.front();
         const auto last = static_cast<double>(table_.size() - 1);
         if (x >= last) return scale_ * table_.back();
@@ -73,10 +74,10 @@ public:
     /// d/d(theta) of operator(), one-sided on the table grid (0 where the law is clamped).
     double slope(double theta) const noexcept
     {
-        const double x = (theta + shift_) / step_;
+        const double x = (theta + shift_) * invStep_;
         if (!(x >= 0.0) || x >= static_cast<double>(table_.size() - 1)) return 0.0;
         const auto i = static_cast<std::size_t>(x);
-        return scale_ * (table_[i + 1] - table_[i]) / step_;
+        return scale_ * (table_[i + 1] - table_[i]) * invStep_;
     }
 
     /// Unshifted, unscaled table value at theta (what the inversion itself produced).
@@ -99,7 +100,7 @@ private:
     }
 
     std::vector<double> table_{1.0, 1.0};
-    double step_ = 1.0, thetaMax_ = 1.0, shift_ = 0.0, scale_ = 1.0;
+    double step_ = 1.0, invStep_ = 1.0, thetaMax_ = 1.0, shift_ = 0.0, scale_ = 1.0;
 };
 
 } // namespace rosin::dsp

@@ -30,7 +30,7 @@ public:
     {
         h_ = 1.0 / sampleRate;
         const double decades = std::log10(xiMax / xiMin);
-        count_ = std::clamp(static_cast<int>(std::ceil(decades * perDecade)) + 1, 2, config::maxThermalPoles - kBlock);
+        count_ = std::clamp(static_cast<int>(std::ceil(decades * perDecade)) + 1, 2, N - 1);
         const double delta = std::log(xiMax / xiMin) / (count_ - 1);
         for (int k = 0; k < count_; ++k) {
             xi_[k] = xiMin * std::exp(delta * k);
@@ -45,20 +45,24 @@ public:
         tailRate_ = tailCapacity_ / h_;
         for (int k = 0; k < count_; ++k) baseDecay_[k] = std::exp(-xi_[k] * h_);
         // Pad to whole blocks with inert poles (zero weight) so the hot loops vectorise.
-        padded_ = (count_ + kBlock - 1) / kBlock * kBlock;
-        for (int k = count_; k < padded_; ++k) { xi_[k] = 1.0; weight_[k] = 0.0; baseDecay_[k] = 0.0; }
-        for (int k = 0; k < padded_; ++k) {
-            xiT_[k] = static_cast<T>(xi_[k]);
-            weightT_[k] = static_cast<T>(weight_[k]);
-            weightXiT_[k] = static_cast<T>(weight_[k] * xi_[k]);
-            baseDecayT_[k] = static_cast<T>(baseDecay_[k]);
+        // Unused slots are inert (zero weight); every loop runs over all of them.
+        for (int k = count_; k < N; ++k) { xi_[k] = 1.0; weight_[k] = 0.0; baseDecay_[k] = 0.0; }
+        for (int k = 0; k < N; ++k) {
+            xiT_[k / kLanes][k % kLanes] = static_cast<T>(xi_[k]);
+            weightT_[k / kLanes][k % kLanes] = static_cast<T>(weight_[k]);
+            weightXiT_[k / kLanes][k % kLanes] = static_cast<T>(weight_[k] * xi_[k]);
+            baseDecayT_[k / kLanes][k % kLanes] = static_cast<T>(baseDecay_[k]);
         }
         kappa_ = -1.0;
         setKappa(0.0);
         reset();
     }
 
-    void reset() noexcept { z_.fill(T(0)); thetaPrev_ = 0.0; }
+    void reset() noexcept
+    {
+        for (Pack& z : z_) z = Pack{};
+        thetaPrev_ = 0.0;
+    }
 
     /// [audio thread] Surface-renewal rate (1/s). Coefficients are recomputed only when it moves
     /// by more than 2 % (or to/from zero), which during sticking is never.
@@ -67,21 +71,19 @@ public:
         if (kappa == kappa_) return;
         if (kappa > 0.0 && kappa_ > 0.0 && std::abs(kappa - kappa_) < 0.02 * kappa_) return;
         kappa_ = kappa;
-        // Runs on most slipping samples: kept in T and in whole blocks so it vectorises.
+        // Runs on most slipping samples: kept in T and in packs so it vectorises.
         const T ek = static_cast<T>(std::exp(-kappa * h_)), kap = static_cast<T>(kappa);
-        std::array<T, kBlock> g{};
-        for (int k = 0; k < padded_; k += kBlock) {
-            for (int j = 0; j < kBlock; ++j) {
-                const T eps = baseDecayT_[k + j] * ek;
-                const T b = (T(1) - eps) / (xiT_[k + j] + kap);
-                decay_[k + j] = eps;
-                gain_[k + j] = b;
-                historyWeight_[k + j] = weightXiT_[k + j] * eps;
-                g[j] += weightT_[k + j] * (T(1) - xiT_[k + j] * b);
-            }
+        Pack g{};
+        for (int p = 0; p < kPacks; ++p) {
+            const Pack eps = baseDecayT_[p] * ek;
+            const Pack b = (T(1) - eps) / (xiT_[p] + kap);
+            decay_[p] = eps;
+            gain_[p] = b;
+            historyWeight_[p] = weightXiT_[p] * eps;
+            g += weightT_[p] * (T(1) - xiT_[p] * b);
         }
         double gamma = 0.0;
-        for (int j = 0; j < kBlock; ++j) gamma += static_cast<double>(g[j]);
+        for (int j = 0; j < kLanes; ++j) gamma += static_cast<double>(g[j]);
         gamma_ = gamma;
         gammaTotal_ = gamma + tailCapacity_ * (1.0 / h_ + kappa);
     }
@@ -92,19 +94,17 @@ public:
     /// History part of this step's flux (depends on past states only).
     double history() const noexcept
     {
-        std::array<T, kBlock> acc{};
-        for (int k = 0; k < padded_; k += kBlock)
-            for (int j = 0; j < kBlock; ++j) acc[j] += historyWeight_[k + j] * z_[k + j];
+        Pack acc = historyWeight_[0] * z_[0];
+        for (int p = 1; p < kPacks; ++p) acc += historyWeight_[p] * z_[p];
         T s = T(0);
-        for (int j = 0; j < kBlock; ++j) s += acc[j];
+        for (int j = 0; j < kLanes; ++j) s += acc[j];
         return static_cast<double>(s) + tailRate_ * thetaPrev_;
     }
 
     /// Commit the step with the new temperature.
     void advance(T theta) noexcept
     {
-        for (int k = 0; k < padded_; k += kBlock)
-            for (int j = 0; j < kBlock; ++j) z_[k + j] = decay_[k + j] * z_[k + j] + gain_[k + j] * theta;
+        for (int p = 0; p < kPacks; ++p) z_[p] = decay_[p] * z_[p] + gain_[p] * theta;
         thetaPrev_ = static_cast<double>(theta);
     }
 
@@ -113,21 +113,24 @@ public:
     double flux(double theta) const noexcept
     {
         double s = tailCapacity_ * kappa_ * theta;
-        for (int k = 0; k < count_; ++k) s += weight_[k] * (theta - xi_[k] * static_cast<double>(z_[k]));
+        for (int k = 0; k < count_; ++k) s += weight_[k] * (theta - xi_[k] * static_cast<double>(z_[k / kLanes][k % kLanes]));
         return s;
     }
 
     int poleCount() const noexcept { return count_; }
 
 private:
-    static constexpr int N = config::maxThermalPoles;
-    static constexpr int kBlock = 4; // one SSE register of floats
-    int padded_ = 0;
+    static constexpr int N = config::thermalPoleSlots;
+    // 16-byte packs of T (GCC/Clang vector extension): 4 floats or 2 doubles per operation.
+    typedef T Pack __attribute__((vector_size(16)));
+    static constexpr int kLanes = 16 / static_cast<int>(sizeof(T));
+    static constexpr int kPacks = N / kLanes;
     double h_ = 1.0 / 48000.0, kappa_ = -1.0, gamma_ = 0.0, gammaTotal_ = 0.0, tailCapacity_ = 0.0, tailRate_ = 0.0, thetaPrev_ = 0.0;
     int count_ = 0;
     std::array<double, N> xi_{}, weight_{}, baseDecay_{};
-    alignas(32) std::array<T, N> z_{}, decay_{}, gain_{}, historyWeight_{};
-    alignas(32) std::array<T, N> xiT_{}, weightT_{}, weightXiT_{}, baseDecayT_{};
+    // Plain arrays: GCC drops the vector attribute of Pack inside std::array<Pack, ...>.
+    Pack z_[kPacks]{}, decay_[kPacks]{}, gain_[kPacks]{}, historyWeight_[kPacks]{};
+    Pack xiT_[kPacks]{}, weightT_[kPacks]{}, weightXiT_[kPacks]{}, baseDecayT_[kPacks]{};
 };
 
 /// Contact temperature rise theta (K above ambient) driven by frictional heating.
@@ -172,12 +175,13 @@ public:
         if (area != areaCached_) {
             areaCached_ = area;
             radiusCached_ = std::sqrt(area / std::numbers::pi);
+            renewalPerSpeed_ = 3.0 / (8.0 * radiusCached_);
         }
         const double radius = radiusCached_;
         const double rhoCDelta = params_.rosinHeatCapacity * params_.layerThickness;
         const double storage = rhoCDelta * area * rate_;
         const double advection = rhoCDelta * params_.advectionWidthFactor * radius * slidingSpeed;
-        rodSide_.setKappa(3.0 * slidingSpeed / (8.0 * radius));
+        rodSide_.setKappa(renewalPerSpeed_ * slidingSpeed); // kappa = 3 |dv| / (8 a)
         const double es = area * params_.stringEffusivity, er = area * params_.rodEffusivity;
         const double slope = std::min(heatSlope, 0.0);
         const double num = storage * theta_ + heat - slope * theta_ + es * stringSide_.history() + er * rodSide_.history();
@@ -199,7 +203,7 @@ public:
 
 private:
     ThermalParams params_;
-    double h_ = 1.0 / 48000.0, rate_ = 48000.0, theta_ = 0.0, areaCached_ = -1.0, radiusCached_ = 0.0, denCached_ = 0.0, invDenCached_ = 0.0;
+    double h_ = 1.0 / 48000.0, rate_ = 48000.0, theta_ = 0.0, areaCached_ = -1.0, radiusCached_ = 0.0, renewalPerSpeed_ = 0.0, denCached_ = 0.0, invDenCached_ = 0.0;
     ConductionBank<T> stringSide_, rodSide_;
 };
 
