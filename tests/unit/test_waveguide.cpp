@@ -16,6 +16,13 @@ BowedStringConfig losslessIdeal()
     c.waveguide.dispersion = false;
     return c;
 }
+
+/// Lossless cello D with integer segment delays: 90 samples to the bridge and back, 911 to the finger.
+void prepareIntegerDelayString(BowedString<double>& s, const BowedStringConfig& c)
+{
+    s.prepare(test::integerDelayRate(c.string), c);
+    s.waveguide().setBeta(test::integerBeta);
+}
 } // namespace
 
 // A force pulse launches f/(2 Z0) both ways; with rigid lossless ends each comes back inverted
@@ -23,10 +30,8 @@ BowedStringConfig losslessIdeal()
 TEST(StringWaveguide, PulseReturnsAfterEachRoundTripWithSignInverted)
 {
     const BowedStringConfig c = losslessIdeal();
-    const double fs = test::integerDelayRate(c.string);
     BowedString<double> s;
-    s.prepare(fs, c);
-    s.waveguide().setBeta(test::integerBeta);
+    prepareIntegerDelayString(s, c);
     const double z0 = c.string.impedance(), f = 1.0, u = f / (2.0 * z0);
     std::vector<double> vh;
     vh.push_back(s.processForce(f));
@@ -44,11 +49,8 @@ TEST(StringWaveguide, PulseReturnsAfterEachRoundTripWithSignInverted)
 
 TEST(StringWaveguide, LosslessEnergyIsConservedAfterThePulse)
 {
-    const BowedStringConfig c = losslessIdeal();
-    const double fs = test::integerDelayRate(c.string);
     BowedString<double> s;
-    s.prepare(fs, c);
-    s.waveguide().setBeta(test::integerBeta);
+    prepareIntegerDelayString(s, losslessIdeal());
     // A smooth pulse over 20 samples, then let it ring for 20 periods.
     for (int n = 0; n < 20; ++n) s.processForce(0.3 * std::sin(std::numbers::pi * n / 20.0));
     const double e0 = s.waveguide().waveEnergy();
