@@ -27,7 +27,11 @@ fs::path OutputSet::add(const fs::path& target)
     const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
     if (!fs::is_directory(dir)) throw LabError(target.string() + ": the directory " + dir.string() + " does not exist");
     std::random_device rd;
-    const fs::path tmp = dir / ("." + target.filename().string() + ".tmp" + std::to_string(rd() % 1000000));
+    std::string name = ".";
+    name += target.filename().string();
+    name += ".tmp";
+    name += std::to_string(rd() % 1000000);
+    const fs::path tmp = dir / name;
     files_.emplace_back(tmp, target);
     return tmp;
 }

@@ -6,11 +6,19 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "rosin/dsp.h"
 #include "rosin/lab/Bench.h"
+#include "rosin/lab/Classifier.h"
+#include "rosin/lab/Distributed.h"
 #include "rosin/lab/Error.h"
+#include "rosin/lab/FigureSet.h"
+#include "rosin/lab/Figures.h"
+#include "rosin/lab/Guettler.h"
+#include "rosin/lab/Signal.h"
 #include "rosin/lab/Gesture.h"
 #include "rosin/lab/Output.h"
 #include "rosin/lab/Presets.h"
@@ -162,6 +170,121 @@ int runRender(const ModelOptions& m, const std::string& gestureName, const Gestu
     return 0;
 }
 
+struct GuettlerCli {
+    double aMin = 0.15, aMax = 3.0, fMin = 0.15, fMax = 3.0;
+    int aCount = 20, fCount = 20, variants = 1;
+    std::vector<double> betas{0.0899};
+    std::uint64_t seed = 1;
+    double sampleRate = 48000.0;
+    std::string out = "guettler";
+    bool noBounds = false, noFit = false, quiet = false;
+};
+
+int runGuettler(const ModelOptions& m, const GuettlerCli& g)
+{
+    SweepSpec spec;
+    spec.config = m.build();
+    spec.label = m.model + (m.model == "enhanced" ? " (" + m.speedFunction + ")" : "") + ", " + m.contact;
+    spec.sampleRate = g.sampleRate;
+    spec.accelerations = SweepSpec::grid(g.aMin, g.aMax, g.aCount);
+    spec.forces = SweepSpec::grid(g.fMin, g.fMax, g.fCount);
+    spec.betas = g.betas;
+    spec.variants = g.variants;
+    spec.seed = g.seed;
+    const Distributed& dist = Distributed::instance();
+    OutputSet outputs;
+    fs::path csv, json, png;
+    if (dist.isRoot()) {
+        csv = outputs.add(g.out + ".csv");
+        json = outputs.add(g.out + ".json");
+        png = outputs.add(g.out + ".png");
+    }
+    Progress progress("sweep", !g.quiet && dist.isRoot());
+    const SweepResult r = runSweep(spec, [&](double x) { progress.update(x); });
+    progress.finish();
+    if (!dist.isRoot()) return 0;
+    writeSweepCsv(csv, r);
+    writeSweepJson(json, r);
+    DiagramOptions o;
+    o.bounds = !g.noBounds;
+    o.fit = !g.noFit;
+    o.muS = dsp::steadySliding(spec.config.friction.fit, 0.0).mu;
+    writeGuettlerPng(png, r, o);
+    outputs.commit();
+    if (!g.quiet) {
+        const std::size_t cells = r.cells.size();
+        std::printf("%s on %s: %d of %zu cells reach Helmholtz within 25 periods%s\n", spec.label.c_str(),
+                    spec.config.string.name.c_str(), r.successCount(), cells,
+                    g.variants > 1 ? (" (min over " + std::to_string(g.variants) + " variants)").c_str() : "");
+        for (std::size_t ib = 0; ib < spec.betas.size(); ++ib) {
+            const BoundaryFit fit = fitLowerBoundary(r, ib);
+            if (fit.valid)
+                std::printf("beta %.4g: lower boundary F = %.3f a^p, p = %.3f (95%% CI %.3f..%.3f, %zu columns)\n", spec.betas[ib],
+                            fit.c, fit.p, fit.pLow, fit.pHigh, fit.accelerations.size());
+            else
+                std::printf("beta %.4g: too few boundary points for a fit\n", spec.betas[ib]);
+        }
+        std::printf("%.2f s wall, %.0f strokes/s, %.1f M samples/s on %d process(es); wrote %s.{csv,json,png}\n", r.wallSeconds,
+                    double(cells * static_cast<std::size_t>(g.variants)) / r.wallSeconds, double(r.simulatedSamples) / r.wallSeconds / 1e6,
+                    dist.size(), g.out.c_str());
+    }
+    return 0;
+}
+
+int runClassify(const ModelOptions& m, const std::vector<std::string>& files, const std::string& gestureName,
+                const Gesture& g0, bool measured, int channel, const std::string& out, bool quiet)
+{
+    const dsp::BowedStringConfig config = m.build();
+    Gesture gesture = g0;
+    gesture.kind = parseGestureKind(gestureName);
+    if (gesture.kind == GestureKind::File) throw LabError("--gesture file is not supported by classify");
+    std::vector<std::pair<std::string, Classification>> records;
+    for (const auto& f : files) {
+        const Signal sig = readSignal(f, channel);
+        ClassifierInput in;
+        in.bridgeForce = sig.samples;
+        in.sampleRate = sig.sampleRate;
+        in.f0 = config.string.fundamental();
+        in.beta = gesture.beta;
+        in.z0 = config.string.impedance();
+        in.tension = config.string.tension;
+        in.length = config.string.length;
+        in.bowSpeed = [gesture](double t) { return t < 0 ? 0.0 : gesture.at(t).speed; };
+        in.measured = measured;
+        records.emplace_back(f, classify(in));
+    }
+    OutputSet outputs;
+    const fs::path csvTmp = outputs.add(out + ".csv");
+    const fs::path jsonTmp = outputs.add(out + ".json");
+    {
+        std::unique_ptr<FILE, int (*)(FILE*)> csv(std::fopen(csvTmp.c_str(), "w"), &std::fclose);
+        if (!csv) throw LabError(out + ".csv: cannot write");
+        std::fprintf(csv.get(), "file,regime,success,transient_periods,first_slip_s,bridge_force_before_slip,first_drop,gain,trigger_s,hum_hz,labels\n");
+        nlohmann::json all = nlohmann::json::array();
+        for (const auto& [file, c] : records) {
+            std::fprintf(csv.get(), "%s,%s,%d,%d,%.9g,%.9g,%.9g,%.6g,%.6g,%.0f,%s\n", file.c_str(), regimeName(c.regime), c.success ? 1 : 0,
+                         c.transientPeriods, c.firstSlipTime, c.forceBeforeSlip, c.firstDrop, c.gain, c.triggerTime,
+                         c.humFrequency, c.labels.c_str());
+            all.push_back({{"file", file}, {"regime", regimeName(c.regime)}, {"success", c.success},
+                           {"transient_periods", c.transientPeriods}, {"first_slip_s", c.firstSlipTime},
+                           {"bridge_force_before_slip", c.forceBeforeSlip}, {"first_drop", c.firstDrop}, {"gain", c.gain},
+                           {"trigger_s", c.triggerTime}, {"hum_hz", c.humFrequency}, {"period_labels", c.labels},
+                           {"flybacks_s", c.flybacks}});
+            if (!quiet)
+                std::printf("%s: %s, %s%s, first slip %.2f ms, labels %s\n", file.c_str(), regimeName(c.regime),
+                            c.success ? "Helmholtz after " : "no Helmholtz within 25 periods",
+                            c.success ? (std::to_string(c.transientPeriods) + " periods").c_str() : "", 1e3 * c.firstSlipTime,
+                            c.labels.c_str());
+        }
+        std::unique_ptr<FILE, int (*)(FILE*)> js(std::fopen(jsonTmp.c_str(), "w"), &std::fclose);
+        if (!js) throw LabError(out + ".json: cannot write");
+        const std::string text = nlohmann::json{{"format", "rosin-classify/1"}, {"records", all}}.dump(1);
+        std::fwrite(text.data(), 1, text.size(), js.get());
+    }
+    outputs.commit();
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -248,11 +371,91 @@ int main(int argc, char** argv)
         ->check(CLI::IsMember({"float", "double"}))
         ->capture_default_str();
 
+    // ---- guettler
+    CLI::App* guettlerCmd = app.add_subcommand("guettler", "Guettler diagram: a constant-acceleration stroke from rest for every "
+                                                           "(acceleration, force) cell, classified; table (CSV, JSON) and PNG");
+    guettlerCmd->footer("Colours: light = Helmholtz soon after the first slip, dark = late (25 periods); blue double slip,\n"
+                        "cyan double flyback, red irregular, black no slip; a dot marks S-motion. Dashed lines: Guettler's\n"
+                        "lossless-string bounds; black curve: the fitted lower boundary F = c a^p.\n"
+                        "Runs on all cores; under `mpirun -np N rosin guettler ...` the grid is split over N processes\n"
+                        "and the table is identical to a single-process run.");
+    ModelOptions guettlerModel;
+    guettlerModel.add(guettlerCmd);
+    GuettlerCli gcli;
+    guettlerCmd->add_option("--accel-min", gcli.aMin, "Lowest acceleration (m/s^2)")->check(finiteIn(0.001, 100))->capture_default_str();
+    guettlerCmd->add_option("--accel-max", gcli.aMax, "Highest acceleration (m/s^2)")->check(finiteIn(0.001, 100))->capture_default_str();
+    guettlerCmd->add_option("--accel-count", gcli.aCount, "Accelerations")->check(CLI::Range(1, 400))->capture_default_str();
+    guettlerCmd->add_option("--force-min", gcli.fMin, "Lowest bow force (N)")->check(finiteIn(0.001, 20))->capture_default_str();
+    guettlerCmd->add_option("--force-max", gcli.fMax, "Highest bow force (N)")->check(finiteIn(0.001, 20))->capture_default_str();
+    guettlerCmd->add_option("--force-count", gcli.fCount, "Forces")->check(CLI::Range(1, 400))->capture_default_str();
+    guettlerCmd->add_option("--beta", gcli.betas, "Bow position(s); repeat for several diagrams")
+        ->check(finiteIn(dsp::config::minBeta, dsp::config::maxBeta))
+        ->capture_default_str();
+    guettlerCmd->add_option("--variants", gcli.variants, "1 = plain; N = minimum transient over N perturbed runs (PHYSICS.md 6.7)")
+        ->check(CLI::Range(1, 64))
+        ->capture_default_str();
+    guettlerCmd->add_option("--seed", gcli.seed, "Seed of the perturbations (results are deterministic per seed)")->capture_default_str();
+    guettlerCmd->add_option("--sample-rate", gcli.sampleRate, "Simulation rate (Hz); 48 kHz is converged for maps (see README)")
+        ->check(finiteIn(8000.0, 1.0e6))
+        ->capture_default_str();
+    guettlerCmd->add_option("-o,--out", gcli.out, "Output prefix: OUT.csv, OUT.json, OUT.png")->capture_default_str();
+    guettlerCmd->add_flag("--no-bounds", gcli.noBounds, "Leave out Guettler's theoretical bounds");
+    guettlerCmd->add_flag("--no-fit", gcli.noFit, "Leave out the fitted lower boundary");
+    guettlerCmd->add_flag("-q,--quiet", gcli.quiet, "No progress and no summary");
+
+    // ---- panel
+    CLI::App* panelCmd = app.add_subcommand("panel", "Lay out Guettler diagrams from earlier `rosin guettler` tables side by side");
+    std::vector<std::string> panelFiles, panelTitles;
+    std::string panelOut = "panel.png";
+    int panelColumns = 2;
+    panelCmd->add_option("tables", panelFiles, "JSON tables written by rosin guettler")->required()->check(CLI::ExistingFile);
+    panelCmd->add_option("--title", panelTitles, "Title per diagram, in order (default: the model)");
+    panelCmd->add_option("--columns", panelColumns, "Diagrams per row")->check(CLI::Range(1, 8))->capture_default_str();
+    panelCmd->add_option("-o,--out", panelOut, "PNG to write")->capture_default_str();
+
+    // ---- classify
+    CLI::App* classifyCmd = app.add_subcommand("classify", "Classify bow-stroke transients from bridge-force recordings or renders "
+                                                           "(WAV of any format, or CSV with time_s and bridge_force_N)");
+    classifyCmd->footer("Prints one line per file and writes OUT.csv and OUT.json with one record each: regime, periods to\n"
+                        "Helmholtz, first-slip time, per-period labels (H Helmholtz, S double slip, F double flyback,\n"
+                        "X irregular). --measured removes DC and mains hum, low-passes, and estimates the unknown gain\n"
+                        "and trigger time from the pre-slip ramp of the given gesture.");
+    ModelOptions classifyModel;
+    classifyModel.add(classifyCmd);
+    std::vector<std::string> classifyFiles;
+    std::string classifyGesture = "guettler", classifyOut = "classify";
+    Gesture classifyG;
+    bool measured = false, classifyQuiet = false;
+    int channel = 0;
+    classifyCmd->add_option("files", classifyFiles, "Recordings or renders")->required()->check(CLI::ExistingFile);
+    classifyCmd->add_option("--gesture", classifyGesture, "Gesture of the strokes: guettler, constant, exp-speed, exp-force")
+        ->check(CLI::IsMember({"guettler", "constant", "exp-speed", "exp-force"}))
+        ->capture_default_str();
+    classifyCmd->add_option("--accel", classifyG.acceleration, "Bow acceleration (m/s^2)")->check(finiteIn(-100.0, 100.0))->capture_default_str();
+    classifyCmd->add_option("--speed", classifyG.speed, "Bow speed (m/s)")->check(finiteIn(-10.0, 10.0))->capture_default_str();
+    classifyCmd->add_option("--time-constant", classifyG.timeConstant, "tau of the exponential gestures (s)")->check(finiteIn(1e-4, 10.0));
+    classifyCmd->add_option("--beta", classifyG.beta, "Bow position")->check(finiteIn(dsp::config::minBeta, dsp::config::maxBeta))->capture_default_str();
+    classifyCmd->add_flag("--measured", measured, "Treat the files as recordings (DC, hum, noise, unknown gain and trigger)");
+    classifyCmd->add_option("--channel", channel, "Channel of multi-channel files (0-based)")->check(CLI::Range(0, 64));
+    classifyCmd->add_option("-o,--out", classifyOut, "Output prefix: OUT.csv and OUT.json")->capture_default_str();
+    classifyCmd->add_flag("-q,--quiet", classifyQuiet, "No per-file lines");
+
+    // ---- figures
+    CLI::App* figuresCmd = app.add_subcommand("figures", "Regenerate the Euphonics 9.6 figure set from scratch (PNG + CSV/JSON)");
+    FigureSetOptions figOptions;
+    std::string figDir = "figures";
+    figuresCmd->add_option("-o,--out", figDir, "Output directory")->capture_default_str();
+    figuresCmd->add_option("--sample-rate", figOptions.sweepRate, "Rate of the Guettler sweeps (Hz)")->check(finiteIn(8000.0, 1.0e6))->capture_default_str();
+    figuresCmd->add_option("--variants", figOptions.variants, "Variants of the min-over-N maps")->check(CLI::Range(2, 64))->capture_default_str();
+    figuresCmd->add_option("--grid", figOptions.grid, "Cells per axis")->check(CLI::Range(5, 100))->capture_default_str();
+    figuresCmd->add_option("--seed", figOptions.seed, "Perturbation seed")->capture_default_str();
+    figuresCmd->add_flag("-q,--quiet", figOptions.quiet, "No progress and no summary");
+
     if (argc > 1 && argv[1][0] != '-') {
         bool known = false;
         for (const CLI::App* sub : app.get_subcommands({})) known |= sub->get_name() == argv[1];
         if (!known) {
-            std::fprintf(stderr, "rosin: unknown command '%s' (render, strings, bench; see rosin --help)\n", argv[1]);
+            std::fprintf(stderr, "rosin: unknown command '%s' (render, guettler, panel, classify, figures, strings, bench; see rosin --help)\n", argv[1]);
             return 2;
         }
     }
@@ -273,6 +476,27 @@ int main(int argc, char** argv)
                 std::printf("%-16s %-5s %9.2f %7.3f %7.1f %9.3f %8.3f %8.1f\n", p.id.c_str(), p.note.c_str(),
                             q.fundamental(), q.length, q.tension, 1e3 * q.massPerLength, q.impedance(), q.waveSpeed());
             }
+            return 0;
+        }
+        if (*guettlerCmd) {
+            if (gcli.aMin > gcli.aMax) throw LabError("--accel-min must not exceed --accel-max");
+            if (gcli.fMin > gcli.fMax) throw LabError("--force-min must not exceed --force-max");
+            return runGuettler(guettlerModel, gcli);
+        }
+        if (*panelCmd) {
+            std::vector<SweepResult> sweeps;
+            for (const auto& f : panelFiles) sweeps.push_back(readSweepJson(f));
+            OutputSet outputs;
+            const fs::path tmp = outputs.add(panelOut);
+            writePanelPng(tmp, sweeps, panelTitles, panelColumns, DiagramOptions{});
+            outputs.commit();
+            std::printf("wrote %s (%zu diagrams)\n", panelOut.c_str(), sweeps.size());
+            return 0;
+        }
+        if (*classifyCmd) return runClassify(classifyModel, classifyFiles, classifyGesture, classifyG, measured, channel, classifyOut, classifyQuiet);
+        if (*figuresCmd) {
+            const std::string report = writeFigureSet(figDir, figOptions);
+            if (!figOptions.quiet) std::printf("%s", report.c_str());
             return 0;
         }
         if (*benchCmd) {

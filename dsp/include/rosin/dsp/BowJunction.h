@@ -3,6 +3,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 
 #include "Config.h"
@@ -52,6 +53,22 @@ public:
         reset();
     }
 
+    /// [audio thread] Ambient temperature (C) without rebuilding the temperature law.
+    void setAmbient(double celsius) noexcept
+    {
+        params_.thermal.ambientCelsius = celsius;
+        law_.setShift(params_.thermal.temperatureShift());
+    }
+
+    /// [audio thread] Relative noise on the friction force while slipping (0 = off), from a
+    /// seeded generator: the "different seed" perturbation of PHYSICS.md 6.7.
+    void setSlipNoise(double relative, std::uint64_t seed) noexcept
+    {
+        noiseLevel_ = relative;
+        noiseState_ = seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
+        if (noiseState_ == 0) noiseState_ = 1;
+    }
+
     void reset() noexcept
     {
         thermal_.reset();
@@ -97,6 +114,7 @@ public:
             const double scale = params_.model == FrictionModel::Enhanced ? law_(theta) : 1.0;
             f = solveWithJumpRule(D, fStick, load, scale, twoZ);
         }
+        if (noiseLevel_ > 0.0 && state_ != ContactState::Stick) f *= 1.0 + noiseLevel_ * nextNoise();
         const double v = state_ == ContactState::Stick ? vb : vh + f * invTwoZ_;
         const double dv = std::abs(v - vb);
         heatPerLoadPrev_ = std::abs(f) * dv * invLoadCached_;
@@ -137,6 +155,16 @@ public:
     ThermalContact<T>& thermal() noexcept { return thermal_; }
 
 private:
+    /// Uniform in [-1, 1) from xorshift64*: cheap, seeded, the same on every platform.
+    double nextNoise() noexcept
+    {
+        noiseState_ ^= noiseState_ >> 12;
+        noiseState_ ^= noiseState_ << 25;
+        noiseState_ ^= noiseState_ >> 27;
+        const std::uint64_t r = noiseState_ * 0x2545F4914F6CDD1Dull;
+        return static_cast<double>(r >> 11) * (2.0 / 9007199254740992.0) - 1.0;
+    }
+
     static double finiteOr(T x) noexcept { return std::isfinite(static_cast<double>(x)) ? static_cast<double>(x) : 0.0; }
 
     /// Friction-curve and enhanced models: mu(x) = scale * law(x) falls with sliding speed, so
@@ -212,6 +240,8 @@ private:
     double xPrev_ = 0.0, heatPerLoadPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePerLoadPrev_ = 0.0;
     double muAtRest_ = 1.0, forceCached_ = -1.0, loadCached_ = 0.0, invLoadCached_ = 0.0;
     double zEffCached_ = -1.0, invTwoZ_ = 0.0;
+    double noiseLevel_ = 0.0;
+    std::uint64_t noiseState_ = 1;
 };
 
 } // namespace rosin::dsp

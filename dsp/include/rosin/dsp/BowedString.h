@@ -76,6 +76,7 @@ public:
     const StringWaveguide<T>& waveguide() const noexcept { return waveguide_; }
     StringWaveguide<T>& waveguide() noexcept { return waveguide_; }
     const BowJunction<T>& junction() const noexcept { return junction_; }
+    BowJunction<T>& junction() noexcept { return junction_; }
     double effectiveImpedance() const noexcept { return zEff_; }
     const BowedStringConfig& config() const noexcept { return config_; }
 

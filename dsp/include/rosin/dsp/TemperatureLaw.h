@@ -89,6 +89,9 @@ public:
         return table_[i] + s * (table_[i + 1] - table_[i]);
     }
 
+    /// [audio thread] Ambient and rosin shift without rebuilding the table.
+    void setShift(double kelvin) noexcept { shift_ = kelvin; }
+
     /// Largest temperature rise the steady-sliding data reaches (K); the law is flat above.
     double thetaMax() const noexcept { return thetaMax_; }
 

@@ -1,0 +1,353 @@
+#include "rosin/lab/Classifier.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "rosin/lab/Error.h"
+
+namespace rosin::lab {
+
+const char* regimeName(Regime r)
+{
+    switch (r) {
+    case Regime::Helmholtz: return "Helmholtz";
+    case Regime::SMotion: return "SMotion";
+    case Regime::DoubleSlip: return "DoubleSlip";
+    case Regime::DoubleFlyback: return "DoubleFlyback";
+    case Regime::Irregular: return "Irregular";
+    case Regime::NoSlip: return "NoSlip";
+    }
+    return "?";
+}
+
+bool isSuccess(Regime r) { return r == Regime::Helmholtz || r == Regime::SMotion; }
+
+namespace {
+
+/// Second-order Butterworth low-pass run forwards then backwards (no phase shift, so event
+/// times are not moved).
+void zeroPhaseLowPass(std::vector<double>& x, double fc, double fs)
+{
+    if (fc >= 0.45 * fs || x.size() < 8) return;
+    const double k = std::tan(std::numbers::pi * fc / fs), q = std::numbers::sqrt2 / 2.0;
+    const double norm = 1.0 / (1.0 + k / q + k * k);
+    const double b0 = k * k * norm, b1 = 2.0 * b0, b2 = b0;
+    const double a1 = 2.0 * (k * k - 1.0) * norm, a2 = (1.0 - k / q + k * k) * norm;
+    auto pass = [&](auto begin, auto end) {
+        double x1 = *begin, x2 = *begin, y1 = *begin, y2 = *begin; // start settled on the first value
+        for (auto it = begin; it != end; ++it) {
+            const double y = b0 * *it + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
+            x2 = x1; x1 = *it; y2 = y1; y1 = y;
+            *it = y;
+        }
+    };
+    pass(x.begin(), x.end());
+    pass(x.rbegin(), x.rend());
+}
+
+/// Solves the small normal-equation system A^T A c = A^T y by Gaussian elimination.
+std::vector<double> leastSquares(const std::vector<std::vector<double>>& cols, const std::vector<double>& y)
+{
+    const std::size_t m = cols.size();
+    std::vector<std::vector<double>> a(m, std::vector<double>(m + 1, 0.0));
+    for (std::size_t i = 0; i < m; ++i) {
+        for (std::size_t j = 0; j < m; ++j)
+            for (std::size_t n = 0; n < y.size(); ++n) a[i][j] += cols[i][n] * cols[j][n];
+        for (std::size_t n = 0; n < y.size(); ++n) a[i][m] += cols[i][n] * y[n];
+    }
+    for (std::size_t i = 0; i < m; ++i) {
+        std::size_t pivot = i;
+        for (std::size_t r = i + 1; r < m; ++r)
+            if (std::abs(a[r][i]) > std::abs(a[pivot][i])) pivot = r;
+        std::swap(a[i], a[pivot]);
+        if (std::abs(a[i][i]) < 1e-300) continue;
+        for (std::size_t r = 0; r < m; ++r) {
+            if (r == i) continue;
+            const double f = a[r][i] / a[i][i];
+            for (std::size_t c = i; c <= m; ++c) a[r][c] -= f * a[i][c];
+        }
+    }
+    std::vector<double> c(m, 0.0);
+    for (std::size_t i = 0; i < m; ++i) c[i] = std::abs(a[i][i]) < 1e-300 ? 0.0 : a[i][m] / a[i][i];
+    return c;
+}
+
+/// First sample where the signal falls by more than 5 % of its level (above `base`) within
+/// `window` samples, and by more than `floor` in absolute terms. -1 if none.
+int firstRelativeDrop(const std::vector<double>& f, double base, int window, double floor, int from = 0)
+{
+    const int n = static_cast<int>(f.size());
+    for (int i = std::max(from, 1); i + window < n; ++i) {
+        const double level = f[i] - base;
+        if (level <= floor) continue;
+        double lowest = f[i];
+        for (int j = 1; j <= window; ++j) lowest = std::min(lowest, f[i + j]);
+        if (f[i] - lowest > std::max(0.05 * level, floor)) {
+            // The slip starts at the steepest fall inside the window: the first sample after it.
+            int at = i;
+            for (int j = i; j < i + window; ++j)
+                if (f[j] - f[j + 1] > f[at] - f[at + 1]) at = j;
+            return at + 1;
+        }
+    }
+    return -1;
+}
+
+/// Bow displacement x_b(t) = integral of v_b from the gesture start, sampled on the record.
+std::vector<double> bowDisplacement(const std::function<double(double)>& speed, double fs, int n, double t0)
+{
+    std::vector<double> x(static_cast<std::size_t>(n), 0.0);
+    double acc = 0.0;
+    for (int i = 0; i < n; ++i) {
+        const double t = i / fs - t0;
+        if (t > 0) acc += speed(t) / fs;
+        x[i] = acc;
+    }
+    return x;
+}
+
+struct Calibration {
+    double gain = 1, dc = 0, trigger = 0, hum = 0;
+    std::vector<double> humWave;
+};
+
+/// Recording clean-up: fits DC + gain * (quasi-static bridge force of the gesture started at
+/// t0) + mains hum (50 or 60 Hz and three harmonics) to the pre-slip ramp. The quasi-static
+/// bridge force is T x_b / (beta L) (PHYSICS.md 6.4); its fitted factor is the gain.
+Calibration calibrate(const std::vector<double>& f, const ClassifierInput& in, int roughSlip)
+{
+    Calibration best;
+    const double fs = in.sampleRate;
+    const int n = static_cast<int>(f.size());
+    const int end = std::max(16, roughSlip - static_cast<int>(0.2e-3 * fs));
+    double bestResidual = 1e300;
+    const double stiffness = in.tension / (in.beta * in.length);
+    for (double hum : {50.0, 60.0}) {
+        // Trigger search: coarse grid over the pre-slip time, then refined around the best.
+        double lo = 0.0, hi = end / fs, bestT0 = 0.0;
+        for (int pass = 0; pass < 3; ++pass) {
+            const int steps = 40;
+            double passBest = 1e300, passT0 = lo;
+            for (int s = 0; s <= steps; ++s) {
+                const double t0 = lo + (hi - lo) * s / steps;
+                const auto xb = bowDisplacement(in.bowSpeed, fs, end, t0);
+                std::vector<std::vector<double>> cols(2 + 8, std::vector<double>(static_cast<std::size_t>(end)));
+                for (int i = 0; i < end; ++i) {
+                    cols[0][i] = 1.0;
+                    cols[1][i] = stiffness * xb[i];
+                    for (int h = 1; h <= 4; ++h) {
+                        cols[2 * h][i] = std::sin(2 * std::numbers::pi * hum * h * i / fs);
+                        cols[2 * h + 1][i] = std::cos(2 * std::numbers::pi * hum * h * i / fs);
+                    }
+                }
+                const std::vector<double> y(f.begin(), f.begin() + end);
+                const auto c = leastSquares(cols, y);
+                double r = 0.0;
+                for (int i = 0; i < end; ++i) {
+                    double model = 0.0;
+                    for (std::size_t k = 0; k < cols.size(); ++k) model += c[k] * cols[k][i];
+                    r += (y[i] - model) * (y[i] - model);
+                }
+                if (r < passBest) { passBest = r; passT0 = t0; }
+                if (r < bestResidual && c[1] > 0.0) {
+                    bestResidual = r;
+                    best.gain = c[1];
+                    best.dc = c[0];
+                    best.trigger = t0;
+                    best.hum = hum;
+                    best.humWave.assign(static_cast<std::size_t>(n), 0.0);
+                    for (int i = 0; i < n; ++i)
+                        for (int h = 1; h <= 4; ++h)
+                            best.humWave[i] += c[2 * h] * std::sin(2 * std::numbers::pi * hum * h * i / fs)
+                                               + c[2 * h + 1] * std::cos(2 * std::numbers::pi * hum * h * i / fs);
+                }
+            }
+            bestT0 = passT0;
+            const double span = (hi - lo) / steps;
+            lo = std::max(0.0, bestT0 - span);
+            hi = bestT0 + span;
+        }
+    }
+    return best;
+}
+
+} // namespace
+
+Classification classify(const ClassifierInput& in, const ClassifierSettings& st)
+{
+    if (!(in.sampleRate > 0 && in.f0 > 0 && in.beta > 0 && in.z0 > 0) || !in.bowSpeed)
+        throw LabError("classifier: sample rate, f0, beta, Z0 and the bow speed are all needed");
+    Classification out;
+    const double fs = in.sampleRate, P0 = 1.0 / in.f0, beta = in.beta;
+    std::vector<double> f = in.bridgeForce;
+    const int n = static_cast<int>(f.size());
+    if (n < 16) throw LabError("classifier: the signal is too short");
+    for (double x : f)
+        if (!std::isfinite(x)) throw LabError("classifier: the signal contains NaN or infinite samples");
+    const int window01 = std::max(2, static_cast<int>(std::lround(1e-4 * fs))); // 0.1 ms
+
+    int slip = -1;
+    if (in.measured) {
+        zeroPhaseLowPass(f, std::min(10000.0, 0.4 * fs), fs);
+        // Noise floor from sample-to-sample differences (robust: median absolute deviation).
+        std::vector<double> d;
+        for (int i = 1; i < n; ++i) d.push_back(std::abs(f[i] - f[i - 1]));
+        std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+        const double noise = 1.4826 * d[d.size() / 2];
+        std::vector<double> head(f.begin(), f.begin() + std::min(n, static_cast<int>(2e-3 * fs) + 1));
+        std::nth_element(head.begin(), head.begin() + head.size() / 2, head.end());
+        const int rough = firstRelativeDrop(f, head[head.size() / 2], window01, 8.0 * noise);
+        if (rough < 0) {
+            out.regime = Regime::NoSlip;
+            return out;
+        }
+        const Calibration cal = calibrate(f, in, rough);
+        out.gain = cal.gain;
+        out.triggerTime = cal.trigger;
+        out.humFrequency = cal.hum;
+        for (int i = 0; i < n; ++i) f[i] = (f[i] - cal.dc - cal.humWave[i]) / cal.gain;
+        slip = firstRelativeDrop(f, 0.0, window01, 8.0 * noise / cal.gain, std::max(1, rough - window01 * 10));
+    } else if (!in.stick.empty()) {
+        for (int i = 0; i < n && i < static_cast<int>(in.stick.size()); ++i)
+            if (!in.stick[i]) { slip = i; break; }
+    } else {
+        slip = firstRelativeDrop(f, 0.0, window01, 1e-9);
+    }
+    if (slip < 1) {
+        out.regime = Regime::NoSlip;
+        return out;
+    }
+    const double t0 = out.triggerTime;
+    auto vb = [&](int i) { return in.bowSpeed(i / fs - t0); };
+    out.firstSlipTime = slip / fs - t0;
+    out.forceBeforeSlip = f[slip - 1];
+    {
+        double lowest = f[slip];
+        for (int j = 0; j <= window01 && slip + j < n; ++j) lowest = std::min(lowest, f[slip + j]);
+        out.firstDrop = f[slip - 1] - lowest;
+    }
+
+    // Flybacks: drops within W larger than gamma times the ideal Helmholtz flyback at the
+    // current bow speed; the sign of the bow speed tells which way the sawtooth runs.
+    const int W = std::max(3, static_cast<int>(std::lround(0.15 * beta * P0 * fs)));
+    const int merge = std::max(1, static_cast<int>(0.5 * beta * P0 * fs));
+    std::vector<int> events;
+    {
+        int i = std::max(1, slip - W);
+        while (i + W < n) {
+            const double v = vb(i), s = v >= 0 ? 1.0 : -1.0;
+            const double threshold = st.flybackFraction * 2.0 * in.z0 * std::abs(v) / beta;
+            double lowest = s * f[i];
+            for (int j = 1; j <= W; ++j) lowest = std::min(lowest, s * f[i + j]);
+            if (threshold > 0 && s * f[i] - lowest > threshold) {
+                // Event at the steepest fall within the window.
+                int at = i;
+                double steepest = -1e300;
+                for (int j = 0; j < W; ++j) {
+                    const double fall = s * (f[i + j] - f[i + j + 1]);
+                    if (fall > steepest) { steepest = fall; at = i + j; }
+                }
+                if (!events.empty() && at - events.back() < merge) {
+                    // too close to the previous one: the same flyback seen twice
+                } else {
+                    events.push_back(at);
+                }
+                i = at + 1;
+                continue;
+            }
+            ++i;
+        }
+    }
+    for (int e : events) out.flybacks.push_back(e / fs - t0);
+
+    // Periods from the first slip. Each window runs from a quarter period before the expected
+    // main flyback to three quarters after it, and the next is anchored on this window's first
+    // flyback: a second flyback half a period later (double slip) then falls inside, not on a
+    // window edge.
+    const int maxPeriods = st.capPeriods + st.settledRun;
+    double period = P0 * fs;
+    double anchor = slip;
+    std::size_t next = 0;
+    int previousEvent = -1;
+    std::string labels;
+    std::vector<std::pair<int, int>> hSpans; // flyback pairs of H periods, for S-motion
+    while (static_cast<int>(labels.size()) < maxPeriods && anchor + 0.75 * period <= n) {
+        const double start = anchor - 0.25 * period, end = anchor + 0.75 * period;
+        std::vector<int> inside;
+        while (next < events.size() && events[next] < end) {
+            if (events[next] >= start) inside.push_back(events[next]);
+            ++next;
+        }
+        char label = 'X';
+        if (inside.size() == 1) {
+            const bool first = previousEvent < 0;
+            const double spacing = first ? P0 * fs : inside[0] - previousEvent;
+            if (std::abs(spacing / (P0 * fs) - 1.0) <= st.periodTolerance) {
+                label = 'H';
+                if (!first) {
+                    hSpans.emplace_back(previousEvent, inside[0]);
+                    period = spacing; // running period
+                }
+            }
+        } else if (inside.size() == 2) {
+            const double d = inside[1] - inside[0];
+            if (d < 2.0 * beta * P0 * fs) label = 'F';
+            else if (std::abs(d / (P0 * fs) - 0.5) < 0.25) label = 'S';
+        }
+        labels.push_back(label);
+        if (!inside.empty()) {
+            previousEvent = inside.back();
+            anchor = inside.front() + period;
+        } else {
+            anchor += period;
+        }
+    }
+    out.labels = labels;
+
+    // S-motion: strong ripple on the sticking ramp between two flybacks of an H period.
+    for (auto [a, b] : hSpans) {
+        const int from = a + 2 * W, to = b - W;
+        if (to - from < 8) continue;
+        double sx = 0, sy = 0, sxx = 0, sxy = 0;
+        const int m = to - from;
+        for (int i = from; i < to; ++i) { sx += i; sy += f[i]; sxx += double(i) * i; sxy += double(i) * f[i]; }
+        const double slope = (m * sxy - sx * sy) / (m * sxx - sx * sx), icpt = (sy - slope * sx) / m;
+        double lo = 1e300, hi = -1e300;
+        for (int i = from; i < to; ++i) {
+            const double r = f[i] - (icpt + slope * i);
+            lo = std::min(lo, r);
+            hi = std::max(hi, r);
+        }
+        const double flyback = 2.0 * in.z0 * std::abs(vb(b)) / beta;
+        if (hi - lo > st.sMotionRipple * flyback) ++out.sMotionPeriods;
+    }
+
+    // Transient length: first period that starts a run of settled H periods lasting to the
+    // end of the analysed window.
+    const int K = static_cast<int>(labels.size());
+    for (int k = 0; k <= std::min(st.capPeriods, K - st.settledRun); ++k) {
+        if (labels.find_first_not_of('H', static_cast<std::size_t>(k)) == std::string::npos) {
+            out.transientPeriods = k;
+            break;
+        }
+    }
+    if (out.transientPeriods >= 0) {
+        out.success = true;
+        const int settled = K - out.transientPeriods;
+        out.regime = out.sMotionPeriods * 2 >= settled ? Regime::SMotion : Regime::Helmholtz;
+        return out;
+    }
+    int counts[3] = {0, 0, 0};
+    for (int k = std::min(5, K); k < std::min(st.capPeriods, K); ++k) {
+        if (labels[k] == 'S') ++counts[0];
+        if (labels[k] == 'F') ++counts[1];
+        if (labels[k] == 'X') ++counts[2];
+    }
+    if (counts[0] >= counts[1] && counts[0] >= counts[2] && counts[0] > 0) out.regime = Regime::DoubleSlip;
+    else if (counts[1] >= counts[2] && counts[1] > 0) out.regime = Regime::DoubleFlyback;
+    else out.regime = Regime::Irregular;
+    return out;
+}
+
+} // namespace rosin::lab
