@@ -184,7 +184,8 @@ int runGuettler(const ModelOptions& m, const GuettlerCli& g)
 {
     SweepSpec spec;
     spec.config = m.build();
-    spec.label = m.model + (m.model == "enhanced" ? " (" + m.speedFunction + ")" : "") + ", " + m.contact;
+    spec.label = m.model + (m.model == "enhanced" ? " (" + m.speedFunction + ")" : "") + ", " +
+                 (spec.config.friction.fit == dsp::SteadyFit::WoodhouseGalluzzo ? "WG" : "SW") + " fit, " + m.contact;
     spec.sampleRate = g.sampleRate;
     spec.accelerations = SweepSpec::grid(g.aMin, g.aMax, g.aCount);
     spec.forces = SweepSpec::grid(g.fMin, g.fMax, g.fCount);
