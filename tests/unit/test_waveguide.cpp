@@ -140,3 +140,39 @@ TEST(StringWaveguide, DispersionSharpensUpperPartialsLikeAStiffString)
         EXPECT_GT(got - harmonic, 0.5 * (target - harmonic)) << "partial " << n;
     }
 }
+
+// The second reflection design (MSW83 Gaussian pulses) must be a string too: right pitch and
+// the target Q, so data simulated with it differ from ours only in the details.
+TEST(StringWaveguide, GaussianReflectionsGiveThePitchAndTheQ)
+{
+    BowedStringConfig c;
+    c.waveguide.torsion = false;
+    c.waveguide.gaussianReflections = true;
+    const double fs = 44100.0, f0 = c.string.fundamental();
+    BowedString<double> s;
+    s.prepare(fs, c);
+    s.waveguide().setBeta(0.11);
+    s.processForce(1.0);
+    std::vector<double> out;
+    for (int n = 0; n < static_cast<int>(1.6 * fs); ++n) {
+        s.processForce(0.0);
+        out.push_back(s.waveguide().bridgeForce());
+    }
+    auto dft = [&](double f, int start, int len) {
+        double re = 0, im = 0;
+        for (int n = 0; n < len; ++n) {
+            re += out[start + n] * std::cos(2 * std::numbers::pi * f * n / fs);
+            im += out[start + n] * std::sin(2 * std::numbers::pi * f * n / fs);
+        }
+        return std::hypot(re, im);
+    };
+    double best = f0, bestP = -1;
+    for (double f = f0 * 0.99; f <= f0 * 1.01; f += 0.02) {
+        const double p = dft(f, 0, static_cast<int>(1.0 * fs));
+        if (p > bestP) { bestP = p; best = f; }
+    }
+    EXPECT_NEAR(1200.0 * std::log2(best / f0), 0.0, 3.0);
+    const int len = static_cast<int>(std::lround(20 * fs / f0));
+    const double q = -std::numbers::pi * f0 / std::log(dft(f0, static_cast<int>(1.1 * fs), len) / dft(f0, static_cast<int>(0.1 * fs), len));
+    EXPECT_NEAR(q, c.string.qLow, 0.1 * c.string.qLow);
+}

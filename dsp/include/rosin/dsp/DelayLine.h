@@ -73,6 +73,14 @@ public:
         return t.h0 * at(t.base) + t.h1 * at(t.base + 1) + t.h2 * at(t.base + 2) + t.h3 * at(t.base + 3);
     }
 
+    /// Weighted sum of samples at delays first, first + 1, ... (an FIR read of any kernel).
+    T readKernel(std::size_t first, const T* weights, int count) const noexcept
+    {
+        T acc = T(0);
+        for (int k = 0; k < count; ++k) acc += weights[k] * at(first + static_cast<std::size_t>(k));
+        return acc;
+    }
+
     /// Convenience for tests and setup code: tap and read in one.
     T read(double delay) const noexcept { return read(tap(delay)); }
 

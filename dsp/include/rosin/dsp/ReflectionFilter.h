@@ -111,4 +111,36 @@ struct DispersionChain {
     }
 };
 
+/// MSW83-style reflection (PHYSICS.md 1.2): a delayed Gaussian pulse of width sigma and area
+/// 1 - eps, |R| = (1 - eps) exp(-w^2 sigma^2 / 2). Realised as an FIR read around the delay,
+/// so it also does the fractional delay. Fitted to the same two target magnitudes as the
+/// one-pole design; the pulse is symmetric, so it adds no phase delay.
+template <typename T>
+struct GaussianReflection {
+    static constexpr int kMaxTaps = 24;
+    std::size_t first = 1; ///< delay of the first tap
+    int taps = 1;
+    T weights[kMaxTaps]{T(1)};
+
+    /// delay (samples, >= 1), magnitudes m1 at w1 and m2 at w2 (rad/sample), m2 < m1.
+    void design(double delay, double m1, double w1, double m2, double w2) noexcept
+    {
+        double sigma2 = 0.0;
+        if (m2 < m1 && w2 > w1) sigma2 = 2.0 * std::log(m1 / m2) / (w2 * w2 - w1 * w1);
+        const double sigma = std::sqrt(std::max(sigma2, 0.09)); // at least 0.3 samples: a smooth kernel
+        const double area = m1 * std::exp(0.5 * w1 * w1 * sigma * sigma);
+        const int reach = std::min(kMaxTaps / 2 - 1, static_cast<int>(std::ceil(4.0 * sigma)) + 1);
+        const double lo = std::max(1.0, std::floor(delay) - reach);
+        first = static_cast<std::size_t>(lo);
+        taps = std::min(kMaxTaps, static_cast<int>(std::floor(delay) + reach + 1 - lo + 1));
+        double sum = 0.0;
+        for (int k = 0; k < taps; ++k) {
+            const double d = (lo + k - delay) / sigma;
+            weights[k] = static_cast<T>(std::exp(-0.5 * d * d));
+            sum += static_cast<double>(weights[k]);
+        }
+        for (int k = 0; k < taps; ++k) weights[k] = static_cast<T>(static_cast<double>(weights[k]) * area / sum);
+    }
+};
+
 } // namespace rosin::dsp

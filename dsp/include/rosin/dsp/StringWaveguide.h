@@ -24,6 +24,9 @@ struct WaveguideOptions {
     bool torsion = true;      ///< torsional waves (lower the load-line slope)
     bool dispersion = false;  ///< bending-stiffness allpasses in the finger-side reflection
     int dispersionSections = 2;
+    /// MSW83 Gaussian-pulse reflections instead of one-pole loss + Lagrange delay (a second,
+    /// independent design: data simulated with it tests that analysis does not depend on ours).
+    bool gaussianReflections = false;
 };
 
 template <typename T>
@@ -86,6 +89,21 @@ public:
         tapFinger_ = fingerSide_.tap(delayFinger_);
         tapTorsionBridge_ = torsionBridge_.tap(delayTorsionBridge_);
         tapTorsionFinger_ = torsionFinger_.tap(delayTorsionFinger_);
+        if (options_.gaussianReflections) {
+            auto design = [&](GaussianReflection<T>& g, double delay, double tau, bool torsional) {
+                const double etaLow = torsional ? 1.0 / params_.qTorsion
+                                                : lossFactor(f0_, f0_, params_.qLow, params_.qHigh, params_.qHighFrequency);
+                const double etaHigh = torsional ? 1.0 / params_.qTorsion
+                                                 : lossFactor(fLossProbe_, f0_, params_.qLow, params_.qHigh, params_.qHighFrequency);
+                const double m1 = options_.losses ? segmentMagnitude(f0_, tau, etaLow) : 1.0;
+                const double m2 = options_.losses ? segmentMagnitude(fLossProbe_, tau, etaHigh) : 1.0;
+                g.design(delay, m1, w0_, m2, wLossProbe_);
+            };
+            design(gaussBridge_, 0.5 * tau1 * fs_, tau1, false);
+            design(gaussFinger_, tau2 * fs_, tau2, false);
+            design(gaussTorsionBridge_, tau1t * fs_, tau1t, true);
+            design(gaussTorsionFinger_, tau2t * fs_, tau2t, true);
+        }
     }
 
     /// [audio thread] Reads the incoming waves of this sample; returns v_h (PHYSICS.md 1.3).
@@ -94,6 +112,7 @@ public:
         const T arriving = bridgeOut_.read(tapBridgeOut_);
         const T reflected = -lossBridge_.process(arriving);
         bridgeForce_ = static_cast<T>(z0_) * (arriving - reflected);
+        if (options_.gaussianReflections) return beginSampleGaussian(arriving);
         u1In_ = bridgeBack_.read(tapBridgeBack_);
         bridgeBack_.write(reflected);
         u2In_ = -lossFinger_.process(dispersion_.process(fingerSide_.read(tapFinger_)));
@@ -154,6 +173,21 @@ public:
     double fingerRoundTripDelay() const noexcept { return delayFinger_; }
 
 private:
+    /// Gaussian-pulse variant: the reflection at the bridge is pure (sign only) and the whole
+    /// bridge-side smear and loss sits in the way back; the bridge sees the arriving wave.
+    T beginSampleGaussian(T arriving) noexcept
+    {
+        bridgeForce_ = static_cast<T>(2.0 * z0_) * arriving;
+        u1In_ = -bridgeBack_.readKernel(gaussBridge_.first, gaussBridge_.weights, gaussBridge_.taps);
+        bridgeBack_.write(arriving);
+        u2In_ = -fingerSide_.readKernel(gaussFinger_.first, gaussFinger_.weights, gaussFinger_.taps);
+        if (options_.torsion) {
+            u1tIn_ = -torsionBridge_.readKernel(gaussTorsionBridge_.first, gaussTorsionBridge_.weights, gaussTorsionBridge_.taps);
+            u2tIn_ = -torsionFinger_.readKernel(gaussTorsionFinger_.first, gaussTorsionFinger_.weights, gaussTorsionFinger_.taps);
+        }
+        return u1In_ + u2In_ + u1tIn_ + u2tIn_;
+    }
+
     void designLoss(OnePoleLoss<T>& filter, double tau, bool torsional) noexcept
     {
         if (!options_.losses) { filter.setIdentity(); return; }
@@ -204,6 +238,7 @@ private:
     DelayLine<T> bridgeOut_, bridgeBack_, fingerSide_, torsionBridge_, torsionFinger_;
     OnePoleLoss<T> lossBridge_, lossFinger_, lossTorsionBridge_, lossTorsionFinger_;
     DispersionChain<T> dispersion_;
+    GaussianReflection<T> gaussBridge_, gaussFinger_, gaussTorsionBridge_, gaussTorsionFinger_;
     double delayBridgeOut_ = 1, delayBridgeBack_ = 1, delayFinger_ = 1, delayTorsionBridge_ = 1, delayTorsionFinger_ = 1;
     typename DelayLine<T>::Tap tapBridgeOut_, tapBridgeBack_, tapFinger_, tapTorsionBridge_, tapTorsionFinger_;
     T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0);

@@ -1,0 +1,48 @@
+// Measurement sets `rosin-measurement/1` (shared/docs/MEASUREMENT_FORMAT.md): a folder with a
+// manifest and one bridge-force file per stroke, from a rig or from any simulator.
+#pragma once
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rosin::lab {
+
+struct MeasuredStroke {
+    std::string id;
+    std::filesystem::path file;
+    int channel = 0;
+    // Gesture (by kind): guettler uses accel and force; exp_speed v0 and tv (and force);
+    // exp_force speed, f0 and tf.
+    double accel = 0, force = 0, v0 = 0, tv = 0, speed = 0, f0 = 0, tf = 0;
+    std::optional<double> trigger;   ///< s into the file where the gesture starts, when known
+    std::vector<double> signal;      ///< in the sensor's units, at the set's sample rate
+};
+
+struct MeasurementSet {
+    std::filesystem::path folder;
+    std::string description;
+    // rig.string (f0 required; the others may be filled from a preset of the same name)
+    std::string stringName;
+    double f0 = 0;
+    std::optional<double> length, tension, z0;
+    double beta = 0;
+    std::string exciter = "unknown";   ///< bow, rod or unknown
+    std::optional<double> ambient;     ///< C
+    std::string units = "N";           ///< N (calibrated) or V (scale unknown)
+    double sampleRate = 0;             ///< the manifest's rate: authoritative
+    std::string gesture = "guettler";  ///< guettler, exp_speed, exp_force
+    std::vector<MeasuredStroke> strokes;
+    std::optional<std::filesystem::path> steadySliding;
+    std::vector<std::string> warnings; ///< what the reader had to decide (said, not silently done)
+};
+
+/// Reads and checks a set. Throws LabError naming the file and the field on any breach of
+/// the format; reads every signal so a broken file is found before anything is computed.
+MeasurementSet readMeasurementSet(const std::filesystem::path& folder);
+
+/// Writes a set (manifest + signal files) into `folder`, which must not exist yet; the whole
+/// folder appears only when complete.
+void writeMeasurementSet(const std::filesystem::path& folder, const MeasurementSet& set, int wavFormat);
+
+} // namespace rosin::lab

@@ -1,0 +1,57 @@
+// `rosin synth-data`: measurement sets simulated by a model with chosen hidden effects
+// (shared/docs/DIAGNOSIS.md vocabulary) and the artefacts of a real rig, so that diagnosis can
+// be tested against a known answer. The answer goes to a separate truth file, never into the set.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "rosin/dsp.h"
+#include "rosin/lab/Measurement.h"
+
+namespace rosin::lab {
+
+/// Effect ids of DIAGNOSIS.md.
+inline const std::vector<std::string>& effectIds()
+{
+    static const std::vector<std::string> ids{"thermal_memory", "rate_dependence", "hertzian_contact",
+                                              "rosin_temperature_shift", "torsional_compliance"};
+    return ids;
+}
+
+struct SynthSpec {
+    std::vector<std::string> effects;   ///< empty = the baseline model ("none")
+    std::map<std::string, double> params; ///< r_A, load_exponent, shift_k, zt_ratio; drawn from the seed if absent
+    std::uint64_t seed = 1;
+    int grid = 12;                        ///< strokes per axis (grid x grid Guettler strokes)
+    double aMin = 0.15, aMax = 3.0, fMin = 0.15, fMax = 3.0, beta = 0.0899;
+    double simRate = 96000.0;             ///< rate of the simulation behind the data
+    double outRate = 48000.0;             ///< rate of the written files
+    std::string units = "V";              ///< V: an unknown gain is applied; N: calibrated
+    double noise = 0.01;                  ///< white noise, relative to the ideal flyback at 1 m/s / beta... in N
+    double humHz = 50.0, humLevel = 0.03; ///< mains hum (N before gain), 0 Hz = none
+    double dcLevel = 0.2;                 ///< DC offset (N before gain)
+    double triggerMax = 0.02;             ///< gesture starts up to this late in each file (s)
+    double jitter = 0.01;                 ///< per-stroke relative jitter of true force and acceleration
+    double seconds = 0.35;                ///< length of each stroke after the trigger
+    bool gaussianReflections = false;     ///< another reflection-filter design than the project's own
+};
+
+struct SynthTruth {
+    std::vector<std::string> effects;
+    std::map<std::string, double> params;
+    double gain = 1.0; ///< signal units per newton
+    std::map<std::string, double> triggers; ///< stroke id -> gesture start in its file (s)
+};
+
+/// Simulates the set (all cores) and returns it with the hidden truth.
+MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress = {});
+
+/// The model of DIAGNOSIS.md's baseline (friction curve, Amontons, no torsion, reference rosin)
+/// with the given effects switched on.
+dsp::BowedStringConfig modelWithEffects(const std::vector<std::string>& effects, const std::map<std::string, double>& params);
+
+} // namespace rosin::lab

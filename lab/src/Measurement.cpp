@@ -1,0 +1,260 @@
+#include "rosin/lab/Measurement.h"
+
+#include <sndfile.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "rosin/lab/Error.h"
+#include "rosin/lab/Output.h"
+
+namespace rosin::lab {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+[[noreturn]] void fail(const fs::path& file, const std::string& field, const std::string& what)
+{
+    throw LabError(file.string() + ": field '" + field + "' " + what);
+}
+
+double positive(const json& obj, const char* key, const fs::path& file, const std::string& where, bool required = true,
+                double def = 0.0)
+{
+    if (!obj.is_object() || !obj.contains(key)) {
+        if (required) fail(file, where + key, "is missing");
+        return def;
+    }
+    const json& v = obj[key];
+    if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() <= 0.0)
+        fail(file, where + key, "must be a positive number");
+    return v.get<double>();
+}
+
+std::vector<double> readWavChannel(const fs::path& file, int channel, double manifestRate, std::vector<std::string>& warnings)
+{
+    SF_INFO info{};
+    SNDFILE* sf = sf_open(file.c_str(), SFM_READ, &info);
+    if (!sf) throw LabError(file.string() + ": not a readable WAV (" + sf_strerror(nullptr) + ")");
+    if (channel < 0 || channel >= info.channels) {
+        sf_close(sf);
+        throw LabError(file.string() + ": channel " + std::to_string(channel) + " does not exist (the file has " +
+                       std::to_string(info.channels) + ")");
+    }
+    // libsndfile reads a cut-off file up to where the data stops and notes in its log that
+    // the data chunk "should be" shorter than the header says: that is a truncated recording.
+    char log[4096] = {0};
+    sf_command(sf, SFC_GET_LOG_INFO, log, sizeof log);
+    std::vector<double> all(static_cast<std::size_t>(info.frames) * static_cast<std::size_t>(info.channels));
+    const sf_count_t got = sf_readf_double(sf, all.data(), info.frames);
+    sf_close(sf);
+    std::istringstream lines(log);
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("data", 0) == 0 && line.find("should be") != std::string::npos)
+            throw LabError(file.string() + ": truncated: the header's data size is larger than the file (" + line + ")");
+    if (got != info.frames) throw LabError(file.string() + ": truncated: read " + std::to_string(got) + " of " + std::to_string(info.frames) + " frames");
+    if (std::abs(info.samplerate - manifestRate) > 0.5)
+        warnings.push_back(file.string() + ": the file says " + std::to_string(info.samplerate) + " Hz, the manifest " +
+                           std::to_string(manifestRate) + " Hz; the manifest's rate is used");
+    std::vector<double> x(static_cast<std::size_t>(info.frames));
+    for (sf_count_t i = 0; i < info.frames; ++i) {
+        x[i] = all[static_cast<std::size_t>(i) * static_cast<std::size_t>(info.channels) + static_cast<std::size_t>(channel)];
+        if (!std::isfinite(x[i])) throw LabError(file.string() + ": sample " + std::to_string(i) + " is not a finite number");
+    }
+    if (x.size() < 64) throw LabError(file.string() + ": too short (" + std::to_string(x.size()) + " samples)");
+    return x;
+}
+
+std::vector<double> readCsvForce(const fs::path& file, double manifestRate)
+{
+    std::ifstream in(file);
+    if (!in) throw LabError(file.string() + ": cannot open");
+    std::string line;
+    if (!std::getline(in, line)) throw LabError(file.string() + ": empty file");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line != "time_s,force") throw LabError(file.string() + ":1: header must be 'time_s,force'");
+    std::vector<double> t, x;
+    int lineNo = 1;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) continue;
+        const auto comma = line.find(',');
+        if (comma == std::string::npos) throw LabError(file.string() + ":" + std::to_string(lineNo) + ": field 'force' is missing");
+        auto number = [&](const std::string& s, const char* field) {
+            try {
+                std::size_t used = 0;
+                const double v = std::stod(s, &used);
+                if (used == s.size() && std::isfinite(v)) return v;
+            } catch (const std::exception&) {
+            }
+            throw LabError(file.string() + ":" + std::to_string(lineNo) + ": field '" + field + "' is not a finite number");
+        };
+        t.push_back(number(line.substr(0, comma), "time_s"));
+        x.push_back(number(line.substr(comma + 1), "force"));
+    }
+    if (x.size() < 64) throw LabError(file.string() + ": too short (" + std::to_string(x.size()) + " rows)");
+    const double rate = static_cast<double>(t.size() - 1) / (t.back() - t.front());
+    if (!(rate > 0) || std::abs(rate / manifestRate - 1.0) > 0.01)
+        throw LabError(file.string() + ": field 'time_s' steps at " + std::to_string(rate) +
+                       " Hz, contradicting the manifest's sample_rate_hz " + std::to_string(manifestRate));
+    return x;
+}
+
+} // namespace
+
+MeasurementSet readMeasurementSet(const fs::path& folder)
+{
+    const fs::path manifest = folder / "manifest.json";
+    if (!fs::is_directory(folder)) throw LabError(folder.string() + ": no such measurement set folder");
+    std::ifstream in(manifest);
+    if (!in) throw LabError(manifest.string() + ": missing (every set needs a manifest.json)");
+    json doc;
+    try {
+        doc = json::parse(in);
+    } catch (const json::parse_error& e) {
+        throw LabError(manifest.string() + ": not valid JSON (" + e.what() + ")");
+    }
+    if (!doc.is_object() || doc.value("format", "") != "rosin-measurement/1")
+        fail(manifest, "format", "must be \"rosin-measurement/1\"");
+    MeasurementSet set;
+    set.folder = folder;
+    set.description = doc.value("description", "");
+    if (!doc.contains("rig") || !doc["rig"].is_object()) fail(manifest, "rig", "is missing");
+    const json& rig = doc["rig"];
+    if (!rig.contains("string") || !rig["string"].is_object()) fail(manifest, "rig.string", "is missing");
+    const json& str = rig["string"];
+    set.stringName = str.value("name", "");
+    set.f0 = positive(str, "f0_hz", manifest, "rig.string.");
+    if (str.contains("length_m")) set.length = positive(str, "length_m", manifest, "rig.string.");
+    if (str.contains("tension_n")) set.tension = positive(str, "tension_n", manifest, "rig.string.");
+    if (str.contains("z0_kg_per_s")) set.z0 = positive(str, "z0_kg_per_s", manifest, "rig.string.");
+    set.beta = positive(rig, "beta", manifest, "rig.");
+    if (set.beta >= 0.5) fail(manifest, "rig.beta", "must be below 0.5");
+    set.exciter = rig.value("exciter", "unknown");
+    if (set.exciter != "bow" && set.exciter != "rod" && set.exciter != "unknown")
+        fail(manifest, "rig.exciter", "must be \"bow\", \"rod\" or \"unknown\"");
+    if (rig.contains("ambient_c")) {
+        if (!rig["ambient_c"].is_number() || !std::isfinite(rig["ambient_c"].get<double>()))
+            fail(manifest, "rig.ambient_c", "must be a number");
+        set.ambient = rig["ambient_c"].get<double>();
+    }
+    if (!rig.contains("sensor") || !rig["sensor"].is_object()) fail(manifest, "rig.sensor", "is missing");
+    const json& sensor = rig["sensor"];
+    if (sensor.value("quantity", "bridge_force") != "bridge_force") fail(manifest, "rig.sensor.quantity", "must be \"bridge_force\"");
+    set.units = sensor.value("units", "");
+    if (set.units != "N" && set.units != "V") fail(manifest, "rig.sensor.units", "must be \"N\" or \"V\"");
+    set.sampleRate = positive(sensor, "sample_rate_hz", manifest, "rig.sensor.");
+    if (!doc.contains("gesture") || !doc["gesture"].is_object()) fail(manifest, "gesture", "is missing");
+    set.gesture = doc["gesture"].value("kind", "");
+    if (set.gesture != "guettler" && set.gesture != "exp_speed" && set.gesture != "exp_force")
+        fail(manifest, "gesture.kind", "must be \"guettler\", \"exp_speed\" or \"exp_force\"");
+    if (!doc.contains("transients") || !doc["transients"].is_array() || doc["transients"].empty())
+        fail(manifest, "transients", "must be a non-empty array");
+    std::set<std::string> ids;
+    int index = 0;
+    for (const json& t : doc["transients"]) {
+        const std::string where = "transients[" + std::to_string(index++) + "].";
+        if (!t.is_object()) fail(manifest, where.substr(0, where.size() - 1), "must be an object");
+        MeasuredStroke s;
+        s.id = t.value("id", "");
+        if (s.id.empty()) fail(manifest, where + "id", "is missing");
+        if (!ids.insert(s.id).second) fail(manifest, where + "id", "repeats '" + s.id + "'");
+        if (!t.contains("file") || !t["file"].is_string()) fail(manifest, where + "file", "is missing");
+        s.file = folder / t["file"].get<std::string>();
+        s.channel = t.value("channel", 0);
+        if (s.channel < 0) fail(manifest, where + "channel", "must not be negative");
+        if (set.gesture == "guettler") {
+            s.accel = positive(t, "accel_m_s2", manifest, where);
+            s.force = positive(t, "force_n", manifest, where);
+        } else if (set.gesture == "exp_speed") {
+            s.v0 = positive(t, "v0_m_s", manifest, where);
+            s.tv = positive(t, "tv_s", manifest, where);
+            s.force = positive(t, "force_n", manifest, where);
+        } else {
+            s.speed = positive(t, "speed_m_s", manifest, where);
+            s.f0 = positive(t, "f0_n", manifest, where);
+            s.tf = positive(t, "tf_s", manifest, where);
+        }
+        if (t.contains("trigger_s")) {
+            if (!t["trigger_s"].is_number() || t["trigger_s"].get<double>() < 0) fail(manifest, where + "trigger_s", "must be a number >= 0");
+            s.trigger = t["trigger_s"].get<double>();
+        }
+        if (!fs::exists(s.file)) fail(manifest, where + "file", "names " + s.file.string() + ", which does not exist");
+        if (s.file.extension() == ".wav") s.signal = readWavChannel(s.file, s.channel, set.sampleRate, set.warnings);
+        else if (s.file.extension() == ".csv") s.signal = readCsvForce(s.file, set.sampleRate);
+        else fail(manifest, where + "file", "must be a .wav or .csv file");
+        set.strokes.push_back(std::move(s));
+    }
+    if (doc.contains("steady_sliding")) {
+        const json& ss = doc["steady_sliding"];
+        if (!ss.is_object() || !ss.contains("file") || !ss["file"].is_string()) fail(manifest, "steady_sliding.file", "is missing");
+        set.steadySliding = folder / ss["file"].get<std::string>();
+        if (!fs::exists(*set.steadySliding)) fail(manifest, "steady_sliding.file", "names a file that does not exist");
+    }
+    return set;
+}
+
+void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int wavFormat)
+{
+    if (fs::exists(folder)) throw LabError(folder.string() + ": already exists (choose a new folder)");
+    const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
+    if (!fs::is_directory(parent)) throw LabError(folder.string() + ": the directory " + parent.string() + " does not exist");
+    // Build under a temporary name, then rename: a half-written set never appears.
+    std::string hidden = ".";
+    hidden += folder.filename().string();
+    hidden += ".partial";
+    const fs::path tmp = parent / hidden;
+    fs::remove_all(tmp);
+    fs::create_directories(tmp / "transients");
+    try {
+        json strokes = json::array();
+        for (const auto& s : set.strokes) {
+            const std::string rel = "transients/" + s.id + ".wav";
+            SF_INFO info{};
+            info.samplerate = static_cast<int>(std::lround(set.sampleRate));
+            info.channels = 1;
+            info.format = SF_FORMAT_WAV | wavFormat;
+            SNDFILE* sf = sf_open((tmp / rel).c_str(), SFM_WRITE, &info);
+            if (!sf) throw LabError((tmp / rel).string() + ": cannot write WAV");
+            if (wavFormat != SF_FORMAT_FLOAT && wavFormat != SF_FORMAT_DOUBLE) {
+                double peak = 0.0;
+                for (double v : s.signal) peak = std::max(peak, std::abs(v));
+                if (peak >= 1.0) {
+                    sf_close(sf);
+                    throw LabError(s.id + ": peak " + std::to_string(peak) + " " + set.units +
+                                   " would clip a PCM file (full scale 1.0): use float WAV or units V");
+                }
+            }
+            sf_write_double(sf, s.signal.data(), static_cast<sf_count_t>(s.signal.size()));
+            sf_close(sf);
+            json t{{"id", s.id}, {"file", rel}, {"channel", 0}};
+            if (set.gesture == "guettler") { t["accel_m_s2"] = s.accel; t["force_n"] = s.force; }
+            else if (set.gesture == "exp_speed") { t["v0_m_s"] = s.v0; t["tv_s"] = s.tv; t["force_n"] = s.force; }
+            else { t["speed_m_s"] = s.speed; t["f0_n"] = s.f0; t["tf_s"] = s.tf; }
+            if (s.trigger) t["trigger_s"] = *s.trigger;
+            strokes.push_back(t);
+        }
+        json str{{"name", set.stringName}, {"f0_hz", set.f0}};
+        if (set.length) str["length_m"] = *set.length;
+        if (set.tension) str["tension_n"] = *set.tension;
+        if (set.z0) str["z0_kg_per_s"] = *set.z0;
+        json rig{{"string", str}, {"beta", set.beta}, {"exciter", set.exciter},
+                 {"sensor", {{"quantity", "bridge_force"}, {"units", set.units}, {"sample_rate_hz", set.sampleRate}}}};
+        if (set.ambient) rig["ambient_c"] = *set.ambient;
+        const json doc{{"format", "rosin-measurement/1"}, {"description", set.description}, {"rig", rig},
+                       {"gesture", {{"kind", set.gesture}}}, {"transients", strokes}};
+        std::ofstream(tmp / "manifest.json") << doc.dump(1) << "\n";
+        fs::rename(tmp, folder);
+    } catch (...) {
+        std::error_code ec;
+        fs::remove_all(tmp, ec);
+        throw;
+    }
+}
+
+} // namespace rosin::lab
