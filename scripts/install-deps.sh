@@ -10,6 +10,7 @@ CORE_PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev
   libcairo2-dev fonts-dejavu-core          # figures (PNG) drawn by lab/
   libopenmpi-dev openmpi-bin               # Guettler sweeps over several processes/machines
+  libnlopt-cxx-dev                         # fitting model extensions in diagnosis
 )
 
 missing=()

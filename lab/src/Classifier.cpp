@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "rosin/lab/Error.h"
+#include "rosin/lab/Resample.h"
 
 namespace rosin::lab {
 
@@ -24,27 +25,6 @@ const char* regimeName(Regime r)
 bool isSuccess(Regime r) { return r == Regime::Helmholtz || r == Regime::SMotion; }
 
 namespace {
-
-/// Second-order Butterworth low-pass run forwards then backwards (no phase shift, so event
-/// times are not moved).
-void zeroPhaseLowPass(std::vector<double>& x, double fc, double fs)
-{
-    if (fc >= 0.45 * fs || x.size() < 8) return;
-    const double k = std::tan(std::numbers::pi * fc / fs), q = std::numbers::sqrt2 / 2.0;
-    const double norm = 1.0 / (1.0 + k / q + k * k);
-    const double b0 = k * k * norm, b1 = 2.0 * b0, b2 = b0;
-    const double a1 = 2.0 * (k * k - 1.0) * norm, a2 = (1.0 - k / q + k * k) * norm;
-    auto pass = [&](auto begin, auto end) {
-        double x1 = *begin, x2 = *begin, y1 = *begin, y2 = *begin; // start settled on the first value
-        for (auto it = begin; it != end; ++it) {
-            const double y = b0 * *it + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
-            x2 = x1; x1 = *it; y2 = y1; y1 = y;
-            *it = y;
-        }
-    };
-    pass(x.begin(), x.end());
-    pass(x.rbegin(), x.rend());
-}
 
 /// Solves the small normal-equation system A^T A c = A^T y by Gaussian elimination.
 std::vector<double> leastSquares(const std::vector<std::vector<double>>& cols, const std::vector<double>& y)
@@ -107,7 +87,7 @@ std::vector<double> bowDisplacement(const std::function<double(double)>& speed, 
     return x;
 }
 
-struct Calibration {
+struct RampFit {
     double gain = 1, dc = 0, trigger = 0, hum = 0;
     std::vector<double> humWave;
 };
@@ -115,9 +95,9 @@ struct Calibration {
 /// Recording clean-up: fits DC + gain * (quasi-static bridge force of the gesture started at
 /// t0) + mains hum (50 or 60 Hz and three harmonics) to the pre-slip ramp. The quasi-static
 /// bridge force is T x_b / (beta L) (PHYSICS.md 6.4); its fitted factor is the gain.
-Calibration calibrate(const std::vector<double>& f, const ClassifierInput& in, int roughSlip)
+RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int roughSlip)
 {
-    Calibration best;
+    RampFit best;
     const double fs = in.sampleRate;
     const int n = static_cast<int>(f.size());
     const int end = std::max(16, roughSlip - static_cast<int>(0.2e-3 * fs));
@@ -141,8 +121,19 @@ Calibration calibrate(const std::vector<double>& f, const ClassifierInput& in, i
                         cols[2 * h + 1][i] = std::cos(2 * std::numbers::pi * hum * h * i / fs);
                     }
                 }
-                const std::vector<double> y(f.begin(), f.begin() + end);
-                const auto c = leastSquares(cols, y);
+                std::vector<double> y(f.begin(), f.begin() + end);
+                std::vector<double> c;
+                if (in.knownGain > 0.0) {
+                    // Gain known: subtract the ramp, fit only DC and hum.
+                    for (int i = 0; i < end; ++i) y[i] -= in.knownGain * cols[1][i];
+                    std::vector<std::vector<double>> rest(cols);
+                    rest.erase(rest.begin() + 1);
+                    c = leastSquares(rest, y);
+                    c.insert(c.begin() + 1, in.knownGain);
+                    for (int i = 0; i < end; ++i) y[i] += in.knownGain * cols[1][i];
+                } else {
+                    c = leastSquares(cols, y);
+                }
                 double r = 0.0;
                 for (int i = 0; i < end; ++i) {
                     double model = 0.0;
@@ -174,6 +165,55 @@ Calibration calibrate(const std::vector<double>& f, const ClassifierInput& in, i
 
 } // namespace
 
+Calibration calibrateRecording(const ClassifierInput& in)
+{
+    if (!(in.sampleRate > 0 && in.beta > 0 && in.tension > 0 && in.length > 0) || !in.bowSpeed)
+        throw LabError("calibration: sample rate, beta, tension, length and the bow speed are all needed");
+    const double fs = in.sampleRate;
+    std::vector<double> f = in.bridgeForce;
+    const int n = static_cast<int>(f.size());
+    if (n < 16) throw LabError("calibration: the signal is too short");
+    for (double x : f)
+        if (!std::isfinite(x)) throw LabError("calibration: the signal contains NaN or infinite samples");
+    const int window01 = std::max(2, static_cast<int>(std::lround(1e-4 * fs)));
+    zeroPhaseLowPass(f, std::min(10000.0, 0.4 * fs), fs);
+    // Noise floor from sample-to-sample differences (robust: median absolute deviation).
+    std::vector<double> d;
+    for (int i = 1; i < n; ++i) d.push_back(std::abs(f[i] - f[i - 1]));
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    const double noise = 1.4826 * d[d.size() / 2];
+    std::vector<double> head(f.begin(), f.begin() + std::min(n, static_cast<int>(2e-3 * fs) + 1));
+    std::nth_element(head.begin(), head.begin() + head.size() / 2, head.end());
+    Calibration out;
+    const int rough = firstRelativeDrop(f, head[head.size() / 2], window01, 8.0 * noise);
+    if (rough < 0) {
+        out.dc = head[head.size() / 2];
+        out.force.resize(f.size());
+        for (int i = 0; i < n; ++i) out.force[i] = f[i] - out.dc;
+        return out;
+    }
+    const RampFit fit = calibrate(f, in, rough);
+    if (fit.humWave.empty()) {
+        // No ramp with a positive gain fits before the first drop (it came too early): keep
+        // the signal's own scale, take out only its starting level, and say so.
+        out.dc = head[head.size() / 2];
+        out.force.resize(f.size());
+        for (int i = 0; i < n; ++i) out.force[i] = f[i] - out.dc;
+        out.firstSlip = rough;
+        out.rampFitted = false;
+        return out;
+    }
+    out.rampFitted = true;
+    out.gain = fit.gain;
+    out.dc = fit.dc;
+    out.trigger = fit.trigger;
+    out.hum = fit.hum;
+    out.force.resize(f.size());
+    for (int i = 0; i < n; ++i) out.force[i] = (f[i] - fit.dc - fit.humWave[i]) / fit.gain;
+    out.firstSlip = firstRelativeDrop(out.force, 0.0, window01, 8.0 * noise / fit.gain, std::max(1, rough - window01 * 10));
+    return out;
+}
+
 Classification classify(const ClassifierInput& in, const ClassifierSettings& st)
 {
     if (!(in.sampleRate > 0 && in.f0 > 0 && in.beta > 0 && in.z0 > 0) || !in.bowSpeed)
@@ -189,30 +229,21 @@ Classification classify(const ClassifierInput& in, const ClassifierSettings& st)
 
     int slip = -1;
     if (in.measured) {
-        zeroPhaseLowPass(f, std::min(10000.0, 0.4 * fs), fs);
-        // Noise floor from sample-to-sample differences (robust: median absolute deviation).
-        std::vector<double> d;
-        for (int i = 1; i < n; ++i) d.push_back(std::abs(f[i] - f[i - 1]));
-        std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-        const double noise = 1.4826 * d[d.size() / 2];
-        std::vector<double> head(f.begin(), f.begin() + std::min(n, static_cast<int>(2e-3 * fs) + 1));
-        std::nth_element(head.begin(), head.begin() + head.size() / 2, head.end());
-        const int rough = firstRelativeDrop(f, head[head.size() / 2], window01, 8.0 * noise);
-        if (rough < 0) {
+        const Calibration cal = calibrateRecording(in);
+        if (cal.firstSlip < 0) {
             out.regime = Regime::NoSlip;
             return out;
         }
-        const Calibration cal = calibrate(f, in, rough);
         out.gain = cal.gain;
         out.triggerTime = cal.trigger;
         out.humFrequency = cal.hum;
-        for (int i = 0; i < n; ++i) f[i] = (f[i] - cal.dc - cal.humWave[i]) / cal.gain;
-        slip = firstRelativeDrop(f, 0.0, window01, 8.0 * noise / cal.gain, std::max(1, rough - window01 * 10));
+        f = cal.force;
+        slip = cal.firstSlip;
     } else if (!in.stick.empty()) {
         for (int i = 0; i < n && i < static_cast<int>(in.stick.size()); ++i)
             if (!in.stick[i]) { slip = i; break; }
     } else {
-        slip = firstRelativeDrop(f, 0.0, window01, 1e-9);
+        slip = firstRelativeDrop(f, 0.0, window01, st.slipFloor);
     }
     if (slip < 1) {
         out.regime = Regime::NoSlip;

@@ -51,6 +51,27 @@ std::vector<double> resample(const std::vector<double>& x, double from, double t
     return y;
 }
 
+/// Second-order Butterworth low-pass run forwards then backwards (no phase shift, so event
+/// times are not moved).
+void zeroPhaseLowPass(std::vector<double>& x, double fc, double fs)
+{
+    if (fc >= 0.45 * fs || x.size() < 8) return;
+    const double k = std::tan(std::numbers::pi * fc / fs), q = std::numbers::sqrt2 / 2.0;
+    const double norm = 1.0 / (1.0 + k / q + k * k);
+    const double b0 = k * k * norm, b1 = 2.0 * b0, b2 = b0;
+    const double a1 = 2.0 * (k * k - 1.0) * norm, a2 = (1.0 - k / q + k * k) * norm;
+    auto pass = [&](auto begin, auto end) {
+        double x1 = *begin, x2 = *begin, y1 = *begin, y2 = *begin; // start settled on the first value
+        for (auto it = begin; it != end; ++it) {
+            const double y = b0 * *it + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
+            x2 = x1; x1 = *it; y2 = y1; y1 = y;
+            *it = y;
+        }
+    };
+    pass(x.begin(), x.end());
+    pass(x.rbegin(), x.rend());
+}
+
 void antiAliasFilter(std::vector<double>& x, double cutoff, double rate)
 {
     if (cutoff >= 0.49 * rate || x.empty()) return;

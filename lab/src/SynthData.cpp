@@ -35,8 +35,8 @@ dsp::BowedStringConfig modelWithEffects(const std::vector<std::string>& effects,
     }
     if (has(effects, "rate_dependence")) {
         c.friction.model = dsp::FrictionModel::Enhanced;
-        c.friction.fit = dsp::SteadyFit::WoodhouseGalluzzo;
         c.friction.thermal.footprintRatio = param("r_A", 1.0);
+        c.friction.speedLaw = dsp::SpeedLaw::withRest(param("h0", 0.563), param("p", 0.4));
     }
     if (has(effects, "hertzian_contact")) {
         c.friction.contactLaw = dsp::ContactLaw::PowerLaw;
@@ -59,22 +59,34 @@ MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::f
     if (spec.units != "V" && spec.units != "N") throw LabError("--units must be V or N");
     std::mt19937_64 rng(spec.seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    // Hidden parameters: drawn from ranges a real rig could show, unless given.
-    truth.effects = spec.effects;
+    // A rosin's softening temperature and a rate dependence only exist on top of thermal
+    // friction, so either one brings thermal memory with it: the truth says so.
+    truth.effects.clear();
+    for (const auto& id : effectIds()) {
+        const bool implied = id == "thermal_memory" && (has(spec.effects, "rosin_temperature_shift") || has(spec.effects, "rate_dependence"));
+        if (has(spec.effects, id) || implied) truth.effects.push_back(id);
+    }
     truth.params.clear();
     auto draw = [&](const char* key, double lo, double hi) {
         const auto it = spec.params.find(key);
         truth.params[key] = it != spec.params.end() ? it->second : lo + (hi - lo) * u(rng);
     };
-    if (has(spec.effects, "thermal_memory") || has(spec.effects, "rate_dependence")) draw("r_A", 0.75, 1.3);
-    if (has(spec.effects, "hertzian_contact")) draw("load_exponent", 0.55, 0.8);
-    if (has(spec.effects, "rosin_temperature_shift")) draw("shift_k", 8.0, 20.0) , truth.params["shift_k"] *= u(rng) < 0.5 ? -1.0 : 1.0;
-    if (has(spec.effects, "torsional_compliance")) draw("zt_ratio", 1.5, 4.0);
+    if (has(truth.effects, "thermal_memory")) draw("r_A", 0.75, 1.3);
+    if (has(truth.effects, "rate_dependence")) {
+        draw("h0", 0.45, 0.85);
+        draw("p", 0.3, 0.5);
+    }
+    if (has(truth.effects, "hertzian_contact")) draw("load_exponent", 0.55, 0.8);
+    if (has(truth.effects, "rosin_temperature_shift")) {
+        draw("shift_k", 8.0, 20.0);
+        if (!spec.params.count("shift_k") && u(rng) < 0.5) truth.params["shift_k"] = -truth.params["shift_k"];
+    }
+    if (has(truth.effects, "torsional_compliance")) draw("zt_ratio", 1.5, 4.0);
     // In volts the recordist sets the input gain so the loudest stroke peaks at 0.3-0.9 of
     // full scale; applied after the simulation, below.
     const double headroom = 0.3 + 0.6 * u(rng);
 
-    dsp::BowedStringConfig config = modelWithEffects(spec.effects, truth.params);
+    dsp::BowedStringConfig config = modelWithEffects(truth.effects, truth.params);
     config.waveguide.gaussianReflections = spec.gaussianReflections;
     MeasurementSet set;
     set.description = "simulated by rosin synth-data (seed " + std::to_string(spec.seed) + ")";

@@ -16,6 +16,7 @@
 #include "rosin/dsp.h"
 #include "rosin/lab/Bench.h"
 #include "rosin/lab/Classifier.h"
+#include "rosin/lab/Diagnose.h"
 #include "rosin/lab/Distributed.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/FigureSet.h"
@@ -446,6 +447,20 @@ int main(int argc, char** argv)
     classifyCmd->add_option("-o,--out", classifyOut, "Output prefix: OUT.csv and OUT.json")->capture_default_str();
     classifyCmd->add_flag("-q,--quiet", classifyQuiet, "No per-file lines");
 
+    // ---- diagnose
+    CLI::App* diagnoseCmd = app.add_subcommand("diagnose", "Compare a measurement set with the model, name what it gets wrong, "
+                                                           "extend it, and measure the gain on held-out strokes");
+    diagnoseCmd->footer("Writes OUT/diagnosis.json (shared/docs/DIAGNOSIS.md), OUT/report.md and its figures\n"
+                        "(maps.png, overlays.png, jumps.png). A broken set is refused before anything is written.");
+    std::string diagSet, diagOut = "diagnosis";
+    DiagnoseOptions diagOptions;
+    diagnoseCmd->add_option("set", diagSet, "Measurement set folder (rosin-measurement/1)")->required();
+    diagnoseCmd->add_option("-o,--out", diagOut, "New output folder")->capture_default_str();
+    diagnoseCmd->add_option("--seed", diagOptions.seed, "Seed of the fit/held-out split and the bootstraps")->capture_default_str();
+    diagnoseCmd->add_option("--sim-rate", diagOptions.simRate, "Simulation rate (Hz)")->check(finiteIn(16000, 400000))->capture_default_str();
+    diagnoseCmd->add_option("--max-evaluations", diagOptions.maxEvaluations, "Model evaluations per candidate fit")->check(CLI::Range(5, 500))->capture_default_str();
+    diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
+
     // ---- synth-data
     CLI::App* synthCmd = app.add_subcommand("synth-data", "Write a measurement set (rosin-measurement/1) simulated with hidden "
                                                           "effects and a real rig's artefacts");
@@ -458,7 +473,7 @@ int main(int argc, char** argv)
     std::vector<std::string> synthParams;
     synthCmd->add_option("-o,--out", synthOut, "New folder for the set (must not exist)")->capture_default_str();
     synthCmd->add_option("--effect", synth.effects, "Hidden effect; repeat for several")->check(CLI::IsMember(effectIds()));
-    synthCmd->add_option("--param", synthParams, "Hidden parameter NAME=VALUE (r_A, load_exponent, shift_k, zt_ratio)");
+    synthCmd->add_option("--param", synthParams, "Hidden parameter NAME=VALUE (r_A, h0, p, load_exponent, shift_k, zt_ratio)");
     synthCmd->add_option("--seed", synth.seed, "Seed of parameters, jitter and artefacts")->capture_default_str();
     synthCmd->add_option("--grid", synth.grid, "Strokes per axis of the Guettler grid")->check(CLI::Range(2, 60))->capture_default_str();
     synthCmd->add_option("--rate", synth.outRate, "Sample rate of the files (Hz)")->check(finiteIn(8000, 384000))->capture_default_str();
@@ -492,7 +507,7 @@ int main(int argc, char** argv)
         bool known = false;
         for (const CLI::App* sub : app.get_subcommands({})) known |= sub->get_name() == argv[1];
         if (!known) {
-            std::fprintf(stderr, "rosin: unknown command '%s' (render, guettler, panel, classify, figures, synth-data, strings, bench; see rosin --help)\n", argv[1]);
+            std::fprintf(stderr, "rosin: unknown command '%s' (render, guettler, panel, classify, figures, synth-data, diagnose, strings, bench; see rosin --help)\n", argv[1]);
             return 2;
         }
     }
@@ -531,12 +546,54 @@ int main(int argc, char** argv)
             return 0;
         }
         if (*classifyCmd) return runClassify(classifyModel, classifyFiles, classifyGesture, classifyG, measured, channel, classifyOut, classifyQuiet);
+        if (*diagnoseCmd) {
+            if (fs::exists(diagOut)) throw LabError(diagOut + ": already exists (choose a new folder)");
+            const MeasurementSet set = readMeasurementSet(diagSet);
+            Progress progress("diagnosing", !diagOptions.quiet);
+            std::string stage;
+            const Diagnosis dg = diagnose(set, diagOptions, [&](const std::string& what, double x) {
+                (void)what;
+                progress.update(x);
+            });
+            progress.finish();
+            std::string hidden = ".";
+            hidden += fs::path(diagOut).filename().string();
+            hidden += ".partial";
+            const fs::path tmp = (fs::path(diagOut).has_parent_path() ? fs::path(diagOut).parent_path() : fs::path(".")) / hidden;
+            fs::remove_all(tmp);
+            try {
+                writeDiagnosis(tmp, dg, diagOptions);
+                fs::rename(tmp, diagOut);
+            } catch (...) {
+                std::error_code ec;
+                fs::remove_all(tmp, ec);
+                throw;
+            }
+            if (!diagOptions.quiet) {
+                for (const auto& w : dg.warnings) std::printf("warning: %s\n", w.c_str());
+                for (const auto& t : dg.trials) {
+                    std::printf("round %d: %-24s", t.round, t.effect.c_str());
+                    for (const auto& [k, v] : t.parameters) std::printf(" %s=%.3g", k.c_str(), v);
+                    std::printf("  held-out fall %.3f [%.3f, %.3f]%s\n", t.gain, t.gainLow, t.gainHigh, t.kept ? "  kept" : "");
+                }
+                if (dg.findings.empty()) std::printf("finding: none (the baseline explains the data)\n");
+                for (const auto& f : dg.findings) {
+                    std::printf("finding: %s", f.effect.c_str());
+                    for (const auto& [name, v] : f.parameters) std::printf("  %s = %.3g [%.3g, %.3g]", name.c_str(), v[0], v[1], v[2]);
+                    std::printf("\n  %s\n", f.evidence.c_str());
+                }
+                std::printf("held-out error %.3f -> %.3f (gain %.0f %%, CI %.0f..%.0f %%); %lld simulations in %.1f s; wrote %s/\n",
+                            dg.baselineError, dg.finalError, 100 * dg.relativeGain, 100 * dg.gainLow, 100 * dg.gainHigh,
+                            dg.simulations, dg.seconds, diagOut.c_str());
+            }
+            return 0;
+        }
         if (*synthCmd) {
             for (const auto& kv : synthParams) {
                 const auto eq = kv.find('=');
                 if (eq == std::string::npos) throw LabError("--param: expected NAME=VALUE, got '" + kv + "'");
                 const std::string key = kv.substr(0, eq);
-                if (key != "r_A" && key != "load_exponent" && key != "shift_k" && key != "zt_ratio")
+                if (key != "r_A" && key != "load_exponent" && key != "shift_k" && key != "zt_ratio" && key != "h0" && key != "p")
                     throw LabError("--param: unknown parameter '" + key + "'");
                 try {
                     synth.params[key] = std::stod(kv.substr(eq + 1));

@@ -23,6 +23,8 @@ struct FrictionParams {
     FrictionModel model = FrictionModel::Thermal;
     SteadyFit fit = SteadyFit::SmithWoodhouse;
     SpeedFunction speedFunction = SpeedFunction::Rod;
+    std::optional<SpeedLaw> speedLaw; ///< overrides the preset speedFunction when set
+    SpeedLaw effectiveSpeedLaw() const noexcept { return speedLaw ? *speedLaw : SpeedLaw::of(speedFunction); }
     ContactLaw contactLaw = ContactLaw::Amontons;
     double contactExponent = 2.0 / 3.0;
     ThermalParams thermal;
@@ -47,7 +49,8 @@ public:
         params_ = params;
         area_.configure(params.contactLaw, params.contactExponent, params.thermal);
         if (params.model == FrictionModel::Thermal) law_.build(params.fit, std::nullopt, params.thermal);
-        if (params.model == FrictionModel::Enhanced) law_.build(params.fit, params.speedFunction, params.thermal);
+        speed_ = params.effectiveSpeedLaw();
+        if (params.model == FrictionModel::Enhanced) law_.build(params.fit, std::optional<SpeedLaw>(speed_), params.thermal);
         thermal_.prepare(sampleRate, params.thermal);
         muAtRest_ = speedLaw(0.0).mu;
         reset();
@@ -123,7 +126,7 @@ public:
         heatSlopePerLoadPrev_ = 0.0;
         if (dv > 0.0 && params_.model == FrictionModel::Thermal) heatSlopePerLoadPrev_ = dv * law_.slope(theta);
         if (dv > 0.0 && params_.model == FrictionModel::Enhanced)
-            heatSlopePerLoadPrev_ = dv * speedFunction(params_.speedFunction, dv).mu * law_.slope(theta);
+            heatSlopePerLoadPrev_ = dv * speed_(dv).mu * law_.slope(theta);
         return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), state_ == ContactState::Stick};
     }
 
@@ -135,7 +138,7 @@ public:
         switch (params_.model) {
         case FrictionModel::FrictionCurve: return load * steadySliding(params_.fit, 0.0).mu;
         case FrictionModel::Thermal: return load * law_(theta);
-        case FrictionModel::Enhanced: return load * law_(theta) * speedFunction(params_.speedFunction, 0.0).mu;
+        case FrictionModel::Enhanced: return load * law_(theta) * speed_(0.0).mu;
         }
         return 0.0;
     }
@@ -143,8 +146,7 @@ public:
     /// mu(x) at zero temperature scale; the speed law used with the jump rule.
     MuSlope speedLaw(double x) const noexcept
     {
-        return params_.model == FrictionModel::Enhanced ? speedFunction(params_.speedFunction, x)
-                                                        : steadySliding(params_.fit, x);
+        return params_.model == FrictionModel::Enhanced ? speed_(x) : steadySliding(params_.fit, x);
     }
 
     ContactState state() const noexcept { return state_; }
@@ -238,6 +240,7 @@ private:
     ThermalContact<T> thermal_;
     ContactState state_ = ContactState::Stick;
     double xPrev_ = 0.0, heatPerLoadPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePerLoadPrev_ = 0.0;
+    SpeedLaw speed_;
     double muAtRest_ = 1.0, forceCached_ = -1.0, loadCached_ = 0.0, invLoadCached_ = 0.0;
     double zEffCached_ = -1.0, invTwoZ_ = 0.0;
     double noiseLevel_ = 0.0;

@@ -33,14 +33,27 @@ enum class SpeedFunction {
     Rod  ///< h_rod = 0.37 (v + 0.35)^{-0.4}  [WG25 eq. 15]
 };
 
-inline MuSlope speedFunction(SpeedFunction kind, double x) noexcept
-{
-    x = std::abs(x);
-    const double c = kind == SpeedFunction::Bow ? 0.5 : 0.37;
-    const double x0 = kind == SpeedFunction::Bow ? 0.27 : 0.35;
-    const double p = std::pow(x + x0, -0.4);
-    return {c * p, -0.4 * c * p / (x + x0)};
-}
+/// Speed function of the enhanced model, h(v) = c (|v| + v0)^(-p). The bow and rod fits are
+/// presets; diagnosis fits its own (DIAGNOSIS.md: h0 = h(0) and p).
+struct SpeedLaw {
+    double c = 0.37, v0 = 0.35, p = 0.4;
+
+    static SpeedLaw of(SpeedFunction kind) noexcept
+    {
+        return kind == SpeedFunction::Bow ? SpeedLaw{0.5, 0.27, 0.4} : SpeedLaw{0.37, 0.35, 0.4};
+    }
+    /// The law with h(0) = h0 and exponent p, keeping v0.
+    static SpeedLaw withRest(double h0, double p, double v0 = 0.35) noexcept { return {h0 * std::pow(v0, p), v0, p}; }
+    double atRest() const noexcept { return c * std::pow(v0, -p); }
+    MuSlope operator()(double x) const noexcept
+    {
+        x = std::abs(x);
+        const double q = std::pow(x + v0, -p);
+        return {c * q, -p * c * q / (x + v0)};
+    }
+};
+
+inline MuSlope speedFunction(SpeedFunction kind, double x) noexcept { return SpeedLaw::of(kind)(x); }
 
 enum class ContactLaw {
     Amontons, ///< real contact area proportional to load (many asperities, a bow)

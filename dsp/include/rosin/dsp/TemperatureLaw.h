@@ -27,7 +27,14 @@ class TemperatureLaw {
 public:
     /// [setup thread] Builds the table. With a speed function it tabulates y = mu_ss / h
     /// (enhanced model); without, mu_ss itself (original thermal model).
+    void build(SteadyFit fit, std::nullopt_t, const ThermalParams& tp) { build(fit, std::optional<SpeedLaw>(), tp); }
+
     void build(SteadyFit fit, std::optional<SpeedFunction> speed, const ThermalParams& tp)
+    {
+        build(fit, speed ? std::optional<SpeedLaw>(SpeedLaw::of(*speed)) : std::nullopt, tp);
+    }
+
+    void build(SteadyFit fit, std::optional<SpeedLaw> speed, const ThermalParams& tp)
     {
         // Dense log grid of speeds; stop at the first maximum of theta_ss (beyond it the
         // inversion is not single-valued: clamp there, PHYSICS.md 3.5 step 3).
@@ -96,10 +103,10 @@ public:
     double thetaMax() const noexcept { return thetaMax_; }
 
 private:
-    static double valueAt(SteadyFit fit, std::optional<SpeedFunction> speed, double v) noexcept
+    static double valueAt(SteadyFit fit, const std::optional<SpeedLaw>& speed, double v) noexcept
     {
         const double mu = steadySliding(fit, v).mu;
-        return speed ? mu / speedFunction(*speed, v).mu : mu;
+        return speed ? mu / (*speed)(v).mu : mu;
     }
 
     std::vector<double> table_{1.0, 1.0};

@@ -22,6 +22,7 @@ struct ClassifierSettings {
     int settledRun = 5;             ///< H periods in a row that count as settled
     double periodTolerance = 0.10;  ///< H spacing within +-10 % of the period
     double sMotionRipple = 0.30;    ///< ripple / flyback above which an H period is S-motion
+    double slipFloor = 1e-9;        ///< a first slip must drop the force by at least this (N)
 };
 
 struct ClassifierInput {
@@ -36,6 +37,9 @@ struct ClassifierInput {
     /// Recording mode: remove DC and hum, low-pass, and estimate gain and trigger time from
     /// the pre-slip ramp. Off for simulations, where the signal is exact and in newtons.
     bool measured = false;
+    /// Recording mode: signal units per newton when already known (e.g. one gain for a whole
+    /// set); then only trigger, DC and hum are fitted. 0 = unknown, fitted per recording.
+    double knownGain = 0.0;
 };
 
 struct Classification {
@@ -54,5 +58,16 @@ struct Classification {
 };
 
 Classification classify(const ClassifierInput& in, const ClassifierSettings& settings = {});
+
+/// The recording clean-up on its own: low-pass at 10 kHz, then DC, mains hum, gain and trigger
+/// fitted to the pre-slip ramp. `force` is the whole record in newtons (same sample times as
+/// the input; the gesture starts at `trigger`); `firstSlip` is its index, -1 if none.
+struct Calibration {
+    std::vector<double> force;
+    double gain = 1, dc = 0, trigger = 0, hum = 0;
+    int firstSlip = -1;
+    bool rampFitted = false; ///< gain and trigger come from a fitted ramp (else gain 1, trigger 0)
+};
+Calibration calibrateRecording(const ClassifierInput& in);
 
 } // namespace rosin::lab

@@ -9,6 +9,10 @@ namespace rosin::lab {
 /// lower rate, so nothing above the new Nyquist frequency folds back.
 std::vector<double> resample(const std::vector<double>& x, double from, double to);
 
+/// Second-order Butterworth low-pass run forwards then backwards: no phase shift, so event
+/// times in the signal do not move.
+void zeroPhaseLowPass(std::vector<double>& x, double cutoff, double rate);
+
 /// Causal 4th-order Butterworth low-pass (two biquads), like a converter's analogue filter.
 void antiAliasFilter(std::vector<double>& x, double cutoff, double rate);
 
