@@ -100,7 +100,19 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
     RampFit best;
     const double fs = in.sampleRate;
     const int n = static_cast<int>(f.size());
-    const int end = std::max(16, roughSlip - static_cast<int>(0.2e-3 * fs));
+    int end = std::max(16, roughSlip - static_cast<int>(0.2e-3 * fs));
+    // Only the quasi-static part of the ramp: with thermal friction the contact creeps well
+    // before the first abrupt drop, so stop where the force passes 60 % of its pre-slip peak.
+    {
+        const double base = f.front();
+        double peak = 0.0;
+        for (int i = 0; i < end; ++i) peak = std::max(peak, f[i] - base);
+        for (int i = 0; i < end; ++i)
+            if (f[i] - base > 0.6 * peak) {
+                end = std::max(16, i);
+                break;
+            }
+    }
     double bestResidual = 1e300;
     const double stiffness = in.tension / (in.beta * in.length);
     for (double hum : {50.0, 60.0}) {

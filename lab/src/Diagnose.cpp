@@ -191,6 +191,19 @@ const std::map<std::string, std::pair<double, double>>& parameterBounds()
     return b;
 }
 
+/// True when the fitted parameters put the effect at its own absence (Hertz exponent 1 is
+/// Amontons, a shift of 0 K is the reference rosin, a very stiff torsion is no torsion): any
+/// held-out "gain" it shows is then the chaos of transients, not physics.
+bool atNull(const std::string& effect, const std::map<std::string, double>& p)
+{
+    auto get = [&](const char* k) { return p.count(k) ? p.at(k) : std::nan(""); };
+    if (effect == "hertzian_contact") return std::abs(get("load_exponent") - 1.0) < 0.05;
+    if (effect == "rosin_temperature_shift") return std::abs(get("shift_k")) < 2.0;
+    if (effect == "torsional_compliance") return get("zt_ratio") > 7.0;
+    if (effect == "rate_dependence") return get("p") < 0.12;
+    return false;
+}
+
 /// Which parameters belong to which effect (for splitting a two-effect step into findings).
 std::string effectOf(const std::string& parameter)
 {
@@ -484,8 +497,12 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         }
         const double base = Engine::mean(currentHeld);
         const Tried* best = nullptr;
-        for (const auto& t : tried)
+        for (const auto& t : tried) {
+            std::map<std::string, double> fitted;
+            for (std::size_t j = 0; j < t.c.names.size(); ++j) fitted[t.c.names[j]] = t.x[j];
+            if (atNull(t.c.effect, fitted)) continue;
             if (t.gain[1] > 0.0 && t.gain[0] >= o.minRelativeGain * base && (!best || t.gain[0] > best->gain[0])) best = &t;
+        }
         if (!best) break;
         for (auto& trial : d.trials)
             if (trial.round == round && trial.effect == best->c.effect) trial.kept = true;
@@ -581,6 +598,22 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         d.finalSim[i] = engine.simulate(d.final, i, &d.finalForce[i]);
         d.measuredForce[i].assign(strokes[i].force.begin(), strokes[i].force.begin() + static_cast<long>(std::min(strokes[i].force.size(), d.baselineForce[i].size())));
     });
+    // 5. The scale again, now from the final model's own pre-slip ramps (with torsion, for one,
+    //    part of the bow's travel rolls the string instead of deflecting it), over the strokes
+    //    whose ramps are long enough to be quasi-static.
+    {
+        double ms = 0, ss = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double t1 = d.measured[i].firstSlip;
+            if (!(t1 > 4.0 / info.f0)) continue;
+            const auto from = static_cast<std::size_t>(2.0 / info.f0 * o.simRate), to = static_cast<std::size_t>(0.6 * t1 * o.simRate);
+            for (std::size_t k = from; k < to && k < d.measuredForce[i].size() && k < d.finalForce[i].size(); ++k) {
+                ms += d.measuredForce[i][k] * d.finalForce[i][k];
+                ss += d.finalForce[i][k] * d.finalForce[i][k];
+            }
+        }
+        if (ss > 0 && ms > 0 && set.units == "V") d.scale /= ms / ss;
+    }
     d.simulations = engine.simulations();
     d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return d;

@@ -173,8 +173,10 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
           "quasi-static ramp T·x_b/(βL) before the first slip; one scale (the median over strokes whose first slip comes after "
           "4 periods) converts the whole set to newtons (" << fmt(d.scale) << " N per unit). Strokes are split into fit and held-out sets "
           "from the seed before any fitting. In each round every extension of DIAGNOSIS.md is fitted on the fit set (NLopt COBYLA); "
-          "the one whose held-out error falls most is kept if the 95 % paired-bootstrap interval of the fall excludes 0 and the fall is at least "
-       << fmt(100 * o.minRelativeGain, "%.0f") << " % of the error. Parameter intervals come from " << o.parameterBootstrap
+          "the one whose held-out error falls most is kept if the 95 % paired-bootstrap interval of the fall excludes 0, the fall is at least "
+       << fmt(100 * o.minRelativeGain, "%.0f") << " % of the error, and its parameters are not at the effect's own absence "
+          "(Hertz exponent within 0.05 of 1, rosin shift within 2 K of 0, Z_t/Z_0 above 7, speed exponent below 0.12): there a "
+          "held-out gain is the chaos of transients, not physics. Parameter intervals come from " << o.parameterBootstrap
        << " refits on bootstrap resamples of the fit set. " << d.simulations << " simulations in " << fmt(d.seconds, "%.1f") << " s.\n";
     for (const auto& w : d.warnings) md << "\nWarning: " << w << "\n";
 }

@@ -48,7 +48,7 @@ struct DiagnoseOptions {
     int bootstrap = 2000;       ///< resamples for the held-out gain CI
     int parameterBootstrap = 10;///< refits on resampled fit sets for parameter CIs
     int maxEvaluations = 30;    ///< NLopt evaluations per candidate fit
-    double minRelativeGain = 0.03;
+    double minRelativeGain = 0.05;  ///< a finding must also lower the held-out error by 5 %
     bool quiet = false;
 };
 
