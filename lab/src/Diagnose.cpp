@@ -12,6 +12,7 @@
 
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Resample.h"
+#include "rosin/lab/Schumacher.h"
 #include "rosin/lab/SynthData.h"
 
 namespace rosin::lab {
@@ -613,6 +614,51 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             }
         }
         if (ss > 0 && ms > 0 && set.units == "V") d.scale /= ms / ss;
+    }
+    // 6. Two-ended steady strokes: bow-point velocity and friction reconstructed from the end
+    //    forces, measured and as the final model would show them.
+    for (const auto& rec : set.twoEnded) {
+        say("two-ended " + rec.id, 0.0);
+        LoopComparison lc;
+        lc.id = rec.id;
+        const double c = 2.0 * info.length * info.f0, tb = info.beta * info.length / c, tn = (1.0 - info.beta) * info.length / c;
+        const double toN = set.units == "V" ? d.scale : 1.0;
+        auto clean = [&](std::vector<double> x) {
+            std::vector<double> head(x.begin(), x.begin() + static_cast<long>(std::min<std::size_t>(x.size(), static_cast<std::size_t>(2e-3 * set.sampleRate) + 1)));
+            const double dc = median(head); // the bow starts from rest: the first moments are the sensor's zero
+            for (double& v : x) v = (v - dc) * toN;
+            zeroPhaseLowPass(x, kCompareCutoff, set.sampleRate);
+            return x;
+        };
+        const Reconstruction m = reconstruct(clean(rec.bridge), clean(rec.far), set.sampleRate, tb, tn, info.z0);
+        const auto P = static_cast<std::size_t>(set.sampleRate / info.f0);
+        if (m.velocity.size() > 4 * P) {
+            lc.measuredV.assign(m.velocity.end() - static_cast<long>(3 * P), m.velocity.end());
+            lc.measuredF.assign(m.friction.end() - static_cast<long>(3 * P), m.friction.end());
+            lc.measuredArea = loopArea(lc.measuredV, lc.measuredF, 0, lc.measuredV.size());
+        }
+        dsp::BowedStringConfig cfg = modelWithEffects(d.final.effects, d.final.params);
+        cfg.string.length = info.length;
+        cfg.string.tension = info.tension;
+        cfg.string.massPerLength = info.tension / std::pow(2.0 * info.length * info.f0, 2.0);
+        dsp::BowedString<double> sim;
+        sim.prepare(o.simRate, cfg);
+        std::vector<double> b(rec.bridge.size() * static_cast<std::size_t>(o.simRate) / static_cast<std::size_t>(set.sampleRate)), f(b.size());
+        for (std::size_t i = 0; i < b.size(); ++i) {
+            const double t = static_cast<double>(i) / o.simRate;
+            b[i] = sim.processSample(rec.force, rec.bowSpeed * std::min(1.0, t / 0.03), info.beta);
+            f[i] = sim.waveguide().farEndForce();
+        }
+        zeroPhaseLowPass(b, kCompareCutoff, o.simRate);
+        zeroPhaseLowPass(f, kCompareCutoff, o.simRate);
+        const Reconstruction s2 = reconstruct(b, f, o.simRate, tb, tn, info.z0);
+        const auto Ps = static_cast<std::size_t>(o.simRate / info.f0);
+        if (s2.velocity.size() > 4 * Ps) {
+            lc.finalV.assign(s2.velocity.end() - static_cast<long>(3 * Ps), s2.velocity.end());
+            lc.finalF.assign(s2.friction.end() - static_cast<long>(3 * Ps), s2.friction.end());
+            lc.finalArea = loopArea(lc.finalV, lc.finalF, 0, lc.finalV.size());
+        }
+        d.loops.push_back(std::move(lc));
     }
     d.simulations = engine.simulations();
     d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -130,9 +130,32 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
                   {"baseline", d.baselineError}, {"final", d.finalError}, {"relative", d.relativeGain},
                   {"ci95", {d.gainLow, d.gainHigh}}, {"n_fit", d.nFit}, {"n_heldout", d.nHeldout}}},
         {"calibration", {{"scale_n_per_unit", d.scale}, {"trigger_offsets_detected", d.triggersDetected}}},
-        {"split", {{"seed", o.seed}, {"fit", d.fitIds}, {"heldout", d.heldoutIds}}},
         {"warnings", d.warnings}};
     std::ofstream(dir / "diagnosis.json") << doc.dump(1) << "\n";
+    // The recorded split (reproducible from the seed), and the two-ended loops, beside it.
+    std::ofstream(dir / "split.json") << json{{"seed", o.seed}, {"fit", d.fitIds}, {"heldout", d.heldoutIds}}.dump(1) << "\n";
+    if (!d.loops.empty()) {
+        json loops = json::array();
+        for (const auto& l : d.loops)
+            loops.push_back({{"id", l.id}, {"measured_area", l.measuredArea}, {"final_area", l.finalArea},
+                             {"measured_orientation", l.measuredArea > 0 ? "anticlockwise" : "clockwise"},
+                             {"final_orientation", l.finalArea > 0 ? "anticlockwise" : "clockwise"}});
+        std::ofstream(dir / "two_ended.json") << json{{"method", "Schumacher reconstruction, ideal ends (PHYSICS.md 7.2 A)"}, {"loops", loops}}.dump(1) << "\n";
+        Canvas canvas(560 * static_cast<int>(d.loops.size()), 520);
+        for (std::size_t k = 0; k < d.loops.size(); ++k) {
+            const auto& l = d.loops[k];
+            double vlo = -0.2, vhi = 0.2, fhi = 0.2, flo = 0.0;
+            for (const auto* v : {&l.measuredV, &l.finalV}) for (double x : *v) { vlo = std::min(vlo, x); vhi = std::max(vhi, x); }
+            for (const auto* v : {&l.measuredF, &l.finalF}) for (double x : *v) { flo = std::min(flo, x); fhi = std::max(fhi, x); }
+            Axes ax(canvas, 90 + 560.0 * k, 50, 440, 380, vlo - 0.05, vhi + 0.05, flo - 0.05, fhi * 1.1);
+            ax.line(l.finalV, l.finalF, colors::blue, 1.2);
+            ax.line(l.measuredV, l.measuredF, colors::black, 1.2);
+            ax.frame(l.id + ": friction against bow-point velocity", "string velocity at the bow (m/s)", "friction force (N)");
+            ax.legend({{std::string("measured, ") + (l.measuredArea > 0 ? "anticlockwise" : "clockwise"), colors::black},
+                       {"final model, " + std::string(l.finalArea > 0 ? "anticlockwise" : "clockwise"), colors::blue}}, false);
+        }
+        canvas.save(dir / "loops.png");
+    }
 
     const SweepResult measured = asMap(d, d.measured, "measured"), base = asMap(d, d.baselineSim, "baseline: " + d.baseline.name()),
                       fin = asMap(d, d.finalSim, "final: " + d.final.name());
@@ -148,7 +171,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
        << "Final: **" << d.final.name() << "**.\n\n";
     md << "Held-out error " << fmt(d.baselineError) << " → " << fmt(d.finalError) << ": relative gain " << fmt(100 * d.relativeGain, "%.0f")
        << " % (95 % CI " << fmt(100 * d.gainLow, "%.0f") << "–" << fmt(100 * d.gainHigh, "%.0f") << " %), on " << d.nHeldout
-       << " strokes not used for fitting (" << d.nFit << " fitted; split from seed " << o.seed << ").\n\n";
+       << " strokes not used for fitting (" << d.nFit << " fitted; split from seed " << o.seed << ", listed in split.json).\n\n";
     md << "## Findings\n\n";
     if (d.findings.empty()) md << "None: no extension lowered the held-out error significantly.\n\n";
     for (const auto& f : d.findings) {
@@ -161,6 +184,14 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
        << base.successCount() << ", final " << fin.successCount() << " of " << measured.cells.size() << ". Lower-boundary exponent p: measured "
        << (bm.valid ? fmt(bm.p) : "n/a") << ", baseline " << (bb.valid ? fmt(bb.p) : "n/a") << ", final " << (bf.valid ? fmt(bf.p) : "n/a") << ".\n\n";
     md << "## Waveforms\n\n![overlays](overlays.png)\n\n## First-slip jumps\n\n![jumps](jumps.png)\n\n";
+    if (!d.loops.empty()) {
+        md << "## Two-ended strokes (Schumacher)\n\n![loops](loops.png)\n\n| stroke | measured loop | final model |\n|---|---|---|\n";
+        for (const auto& l : d.loops)
+            md << "| " << l.id << " | " << (l.measuredArea > 0 ? "anticlockwise" : "clockwise") << " (" << fmt(l.measuredArea) << " N m/s) | "
+               << (l.finalArea > 0 ? "anticlockwise" : "clockwise") << " (" << fmt(l.finalArea) << " N m/s) |\n";
+        md << "\nAnticlockwise loops mean friction is lower on the way back from a slip than on the way out: the contact "
+              "heated while slipping (PHYSICS.md 7.3). A friction-curve model only loops through its jump rule.\n\n";
+    }
     md << "## What was tried\n\n| round | extension | fitted parameters | fit error | held-out fall | 95 % CI | kept |\n|---|---|---|---|---|---|---|\n";
     for (const auto& t : d.trials) {
         std::string ps;

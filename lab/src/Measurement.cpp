@@ -190,6 +190,27 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
         else fail(manifest, where + "file", "must be a .wav or .csv file");
         set.strokes.push_back(std::move(s));
     }
+    if (doc.contains("two_ended")) {
+        if (!doc["two_ended"].is_array()) fail(manifest, "two_ended", "must be an array");
+        int k = 0;
+        for (const json& t : doc["two_ended"]) {
+            const std::string where = "two_ended[" + std::to_string(k++) + "].";
+            TwoEndedRecording r;
+            r.id = t.value("id", "");
+            if (r.id.empty()) fail(manifest, where + "id", "is missing");
+            if (!t.contains("file") || !t["file"].is_string()) fail(manifest, where + "file", "is missing");
+            r.file = folder / t["file"].get<std::string>();
+            if (!fs::exists(r.file)) fail(manifest, where + "file", "names " + r.file.string() + ", which does not exist");
+            r.bowSpeed = positive(t, "bow_speed_m_s", manifest, where);
+            r.force = positive(t, "force_n", manifest, where);
+            r.bridgeChannel = t.value("bridge_channel", 0);
+            r.farChannel = t.value("far_end_channel", 1);
+            if (r.bridgeChannel == r.farChannel) fail(manifest, where + "far_end_channel", "must differ from bridge_channel");
+            r.bridge = readWavChannel(r.file, r.bridgeChannel, set.sampleRate, set.warnings);
+            r.far = readWavChannel(r.file, r.farChannel, set.sampleRate, set.warnings);
+            set.twoEnded.push_back(std::move(r));
+        }
+    }
     if (doc.contains("steady_sliding")) {
         const json& ss = doc["steady_sliding"];
         if (!ss.is_object() || !ss.contains("file") || !ss["file"].is_string()) fail(manifest, "steady_sliding.file", "is missing");
@@ -239,6 +260,26 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
             if (s.trigger) t["trigger_s"] = *s.trigger;
             strokes.push_back(t);
         }
+        json twoEnded = json::array();
+        if (!set.twoEnded.empty()) fs::create_directories(tmp / "two_ended");
+        for (const auto& r : set.twoEnded) {
+            const std::string rel = "two_ended/" + r.id + ".wav";
+            SF_INFO info{};
+            info.samplerate = static_cast<int>(std::lround(set.sampleRate));
+            info.channels = 2;
+            info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
+            SNDFILE* sf = sf_open((tmp / rel).c_str(), SFM_WRITE, &info);
+            if (!sf) throw LabError((tmp / rel).string() + ": cannot write WAV");
+            std::vector<double> frames(2 * r.bridge.size());
+            for (std::size_t i = 0; i < r.bridge.size(); ++i) {
+                frames[2 * i] = r.bridge[i];
+                frames[2 * i + 1] = r.far[i];
+            }
+            sf_writef_double(sf, frames.data(), static_cast<sf_count_t>(r.bridge.size()));
+            sf_close(sf);
+            twoEnded.push_back({{"id", r.id}, {"bow_speed_m_s", r.bowSpeed}, {"force_n", r.force}, {"file", rel},
+                                {"bridge_channel", 0}, {"far_end_channel", 1}});
+        }
         json str{{"name", set.stringName}, {"f0_hz", set.f0}};
         if (set.length) str["length_m"] = *set.length;
         if (set.tension) str["tension_n"] = *set.tension;
@@ -248,7 +289,9 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
         if (set.ambient) rig["ambient_c"] = *set.ambient;
         const json doc{{"format", "rosin-measurement/1"}, {"description", set.description}, {"rig", rig},
                        {"gesture", {{"kind", set.gesture}}}, {"transients", strokes}};
-        std::ofstream(tmp / "manifest.json") << doc.dump(1) << "\n";
+        json full = doc;
+        if (!twoEnded.empty()) full["two_ended"] = twoEnded;
+        std::ofstream(tmp / "manifest.json") << full.dump(1) << "\n";
         fs::rename(tmp, folder);
     } catch (...) {
         std::error_code ec;

@@ -153,6 +153,31 @@ MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::f
             progressLock.unlock();
         }
     });
+    // Steady strokes recorded at both ends, for Schumacher's reconstruction.
+    set.twoEnded.resize(static_cast<std::size_t>(std::max(0, spec.twoEnded)));
+    tbb::parallel_for(0, spec.twoEnded, [&](int k) {
+        std::mt19937_64 r(spec.seed * 104729ull + static_cast<std::uint64_t>(k));
+        std::normal_distribution<double> gauss(0.0, 1.0);
+        TwoEndedRecording& rec = set.twoEnded[static_cast<std::size_t>(k)];
+        rec.id = "steady_" + std::to_string(k + 1);
+        rec.bowSpeed = 0.05 + 0.05 * k;
+        rec.force = 0.8;
+        dsp::BowedString<double> s;
+        s.prepare(spec.simRate, config);
+        std::vector<double> b(static_cast<std::size_t>(0.4 * spec.simRate)), f(b.size());
+        for (std::size_t i = 0; i < b.size(); ++i) {
+            const double t = static_cast<double>(i) / spec.simRate;
+            b[i] = s.processSample(rec.force, rec.bowSpeed * std::min(1.0, t / 0.03), spec.beta);
+            f[i] = s.waveguide().farEndForce();
+        }
+        for (auto* x : {&b, &f}) {
+            antiAliasFilter(*x, 0.45 * spec.outRate, spec.simRate);
+            *x = resample(*x, spec.simRate, spec.outRate);
+            for (double& v : *x) v += spec.dcLevel + spec.noise * gauss(r);
+        }
+        rec.bridge = std::move(b);
+        rec.far = std::move(f);
+    });
     truth.gain = 1.0;
     if (spec.units == "V") {
         double peak = 0.0;
@@ -161,6 +186,9 @@ MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::f
         truth.gain = headroom / peak;
         for (auto& m : set.strokes)
             for (double& v : m.signal) v *= truth.gain;
+        for (auto& rec : set.twoEnded)
+            for (auto* x : {&rec.bridge, &rec.far})
+                for (double& v : *x) v *= truth.gain;
     }
     return set;
 }

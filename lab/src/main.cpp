@@ -489,6 +489,7 @@ int main(int argc, char** argv)
         ->check(CLI::IsMember({"pcm16", "pcm24", "pcm32", "float", "double"}))
         ->capture_default_str();
     synthCmd->add_flag("--gaussian-reflections", synth.gaussianReflections, "Simulate with MSW83 Gaussian-pulse reflections");
+    synthCmd->add_option("--two-ended", synth.twoEnded, "Steady strokes recorded at both string ends")->check(CLI::Range(0, 20))->capture_default_str();
     bool synthQuiet = false;
     synthCmd->add_flag("-q,--quiet", synthQuiet, "No progress and no summary");
 

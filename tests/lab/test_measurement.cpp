@@ -11,6 +11,8 @@
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
 #include "rosin/lab/Resample.h"
+#include "rosin/lab/Schumacher.h"
+#include "rosin/dsp.h"
 #include "rosin/lab/SynthData.h"
 
 using namespace rosin::lab;
@@ -250,4 +252,78 @@ TEST(SynthDataCli, WritesASetAndItsTruthApartAndRefusesToOverwrite)
     EXPECT_FALSE(fs::exists(d / "other"));
     EXPECT_FALSE(fs::exists(d / "other.truth.json"));
     fs::remove_all(d);
+}
+
+TEST(DiagnoseCli, WritesTheDiagnosisAndRefusesABrokenSetWritingNothing)
+{
+    const fs::path d = freshDir("diagcli");
+    const std::string cli = ROSIN_CLI;
+    auto run = [](const std::string& cmd) {
+        FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+        std::string text;
+        char buf[1024];
+        while (std::size_t k = std::fread(buf, 1, sizeof buf, p)) text.append(buf, k);
+        const int status = pclose(p);
+        return std::make_pair(WEXITSTATUS(status), text);
+    };
+    ASSERT_EQ(run(cli + " synth-data --grid 4 --seed 9 -q -o " + (d / "set").string()).first, 0);
+    const auto ok = run(cli + " diagnose " + (d / "set").string() + " --max-evaluations 8 -o " + (d / "out").string());
+    ASSERT_EQ(ok.first, 0) << ok.second;
+    for (const char* f : {"diagnosis.json", "report.md", "maps.png", "overlays.png", "jumps.png", "split.json", "two_ended.json", "loops.png"})
+        EXPECT_TRUE(fs::exists(d / "out" / f)) << f;
+    std::ifstream in(d / "out" / "diagnosis.json");
+    const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (const char* key : {"\"format\": \"rosin-diagnosis/1\"", "\"baseline_model\": \"friction_curve\"", "\"findings\"",
+                            "\"final_model\"", "\"gain\"", "\"ci95\"", "\"n_fit\": 11", "\"n_heldout\": 5", "\"calibration\"",
+                            "\"scale_n_per_unit\"", "\"warnings\""})
+        EXPECT_NE(json.find(key), std::string::npos) << key;
+    // A broken set: refused, naming the file and field, and no output folder appears.
+    fs::remove(d / "set" / "transients" / "a01_f01.wav");
+    const auto bad = run(cli + " diagnose " + (d / "set").string() + " -o " + (d / "out2").string());
+    EXPECT_NE(bad.first, 0);
+    EXPECT_NE(bad.second.find("manifest.json: field 'transients[5].file'"), std::string::npos) << bad.second;
+    EXPECT_FALSE(fs::exists(d / "out2"));
+    // An existing output folder is not overwritten.
+    const auto again = run(cli + " diagnose " + (d / "set").string() + " -o " + (d / "out").string());
+    EXPECT_NE(again.first, 0);
+    EXPECT_NE(again.second.find("already exists"), std::string::npos);
+    fs::remove_all(d);
+}
+
+// With ideal ends the two end forces determine the bow-point velocity and the friction force
+// exactly (PHYSICS.md 7.2); the thermal model's loop then runs anticlockwise (7.3).
+TEST(Schumacher, EndForcesGiveBackTheVelocityAndFrictionAtTheBow)
+{
+    rosin::dsp::BowedStringConfig c;
+    c.friction.model = rosin::dsp::FrictionModel::Thermal;
+    c.waveguide.losses = false;
+    c.waveguide.torsion = false;
+    // 2002 f0: both one-way delays are whole samples (90 to the bridge, 911 to the far end).
+    const double fs = 2002.0 * c.string.fundamental(), beta = 180.0 / 2002.0;
+    rosin::dsp::BowedString<double> s;
+    s.prepare(fs, c);
+    std::vector<double> f1, f2, v, f;
+    for (int n = 0; n < static_cast<int>(0.5 * fs); ++n) {
+        rosin::dsp::BowFrame<double> fr;
+        s.processSample(0.8, 0.1 * std::min(1.0, n / (0.05 * fs)), beta, &fr);
+        f1.push_back(fr.bridgeForce);
+        f2.push_back(s.waveguide().farEndForce());
+        v.push_back(fr.velocity);
+        f.push_back(fr.friction);
+    }
+    const double cw = c.string.waveSpeed(), L = c.string.length;
+    const Reconstruction r = reconstruct(f1, f2, fs, beta * L / cw, (1.0 - beta) * L / cw, c.string.impedance());
+    ASSERT_GT(r.velocity.size(), 1000u);
+    double ev = 0, ef = 0, pv = 0, pf = 0;
+    for (std::size_t k = r.velocity.size() / 2; k < r.velocity.size(); ++k) {
+        const std::size_t n = k + r.first;
+        ev = std::max(ev, std::abs(r.velocity[k] - v[n]));
+        ef = std::max(ef, std::abs(r.friction[k] - f[n]));
+        pv = std::max(pv, std::abs(v[n]));
+        pf = std::max(pf, std::abs(f[n]));
+    }
+    EXPECT_LT(ev, 1e-6 * pv);
+    EXPECT_LT(ef, 1e-6 * pf);
+    const std::size_t P = static_cast<std::size_t>(2002);
+    EXPECT_GT(loopArea(r.velocity, r.friction, r.velocity.size() - 3 * P, r.velocity.size()), 0.0);
 }

@@ -61,6 +61,7 @@ public:
         dispersion_.reset();
         u1In_ = u2In_ = u1tIn_ = u2tIn_ = T(0);
         bridgeForce_ = T(0);
+        farEndForce_ = T(0);
     }
 
     /// [audio thread] Moves the bow point. Cheap closed-form redesign; skipped when unchanged.
@@ -89,6 +90,7 @@ public:
         tapFinger_ = fingerSide_.tap(delayFinger_);
         tapTorsionBridge_ = torsionBridge_.tap(delayTorsionBridge_);
         tapTorsionFinger_ = torsionFinger_.tap(delayTorsionFinger_);
+        tapFarEnd_ = fingerSide_.tap(0.5 * tau2 * fs_); // one way, bow to finger
         if (options_.gaussianReflections) {
             auto design = [&](GaussianReflection<T>& g, double delay, double tau, bool torsional) {
                 const double etaLow = torsional ? 1.0 / params_.qTorsion
@@ -110,6 +112,7 @@ public:
     T beginSample() noexcept
     {
         const T arriving = bridgeOut_.read(tapBridgeOut_);
+        farEndForce_ = static_cast<T>(2.0 * z0_) * fingerSide_.read(tapFarEnd_);
         const T reflected = -lossBridge_.process(arriving);
         bridgeForce_ = static_cast<T>(z0_) * (arriving - reflected);
         if (options_.gaussianReflections) return beginSampleGaussian(arriving);
@@ -138,6 +141,10 @@ public:
 
     /// Force of the string on the bridge for the current sample (valid after beginSample).
     T bridgeForce() const noexcept { return bridgeForce_; }
+    /// Force on the far (finger or nut) end for the current sample, for two-ended measurements
+    /// (PHYSICS.md 7.2): twice Z0 times the wave arriving there, signed like the bridge force.
+    T farEndForce() const noexcept { return farEndForce_; }
+
     /// Transverse part of the history velocity (what the bow would see with torsion ignored).
     T transverseHistory() const noexcept { return u1In_ + u2In_; }
 
@@ -240,8 +247,8 @@ private:
     DispersionChain<T> dispersion_;
     GaussianReflection<T> gaussBridge_, gaussFinger_, gaussTorsionBridge_, gaussTorsionFinger_;
     double delayBridgeOut_ = 1, delayBridgeBack_ = 1, delayFinger_ = 1, delayTorsionBridge_ = 1, delayTorsionFinger_ = 1;
-    typename DelayLine<T>::Tap tapBridgeOut_, tapBridgeBack_, tapFinger_, tapTorsionBridge_, tapTorsionFinger_;
-    T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0);
+    typename DelayLine<T>::Tap tapBridgeOut_, tapBridgeBack_, tapFinger_, tapTorsionBridge_, tapTorsionFinger_, tapFarEnd_;
+    T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0), farEndForce_ = T(0);
 };
 
 } // namespace rosin::dsp

@@ -68,8 +68,16 @@ struct Trial {
     bool kept = false;
 };
 
+/// A two-ended steady stroke: measured and final-model (v, f) loops by Schumacher's method.
+struct LoopComparison {
+    std::string id;
+    double measuredArea = 0, finalArea = 0; ///< signed (v, f) areas: positive = anticlockwise
+    std::vector<double> measuredV, measuredF, finalV, finalF; ///< the last three periods
+};
+
 struct Diagnosis {
     std::vector<Trial> trials;
+    std::vector<LoopComparison> loops;
     std::string setName;
     EffectModel baseline, final;
     std::vector<Finding> findings;

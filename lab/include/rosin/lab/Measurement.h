@@ -19,6 +19,15 @@ struct MeasuredStroke {
     std::vector<double> signal;      ///< in the sensor's units, at the set's sample rate
 };
 
+/// A steady stroke recorded at both string ends (PHYSICS.md 7.2).
+struct TwoEndedRecording {
+    std::string id;
+    std::filesystem::path file;
+    double bowSpeed = 0, force = 0;
+    int bridgeChannel = 0, farChannel = 1;
+    std::vector<double> bridge, far; ///< sensor units, at the set's rate
+};
+
 struct MeasurementSet {
     std::filesystem::path folder;
     std::string description;
@@ -34,6 +43,7 @@ struct MeasurementSet {
     std::string gesture = "guettler";  ///< guettler, exp_speed, exp_force
     std::vector<MeasuredStroke> strokes;
     std::optional<std::filesystem::path> steadySliding;
+    std::vector<TwoEndedRecording> twoEnded;
     std::vector<std::string> warnings; ///< what the reader had to decide (said, not silently done)
 };
 

@@ -38,6 +38,7 @@ struct SynthSpec {
     double jitter = 0.01;                 ///< per-stroke relative jitter of true force and acceleration
     double seconds = 0.35;                ///< length of each stroke after the trigger
     bool gaussianReflections = false;     ///< another reflection-filter design than the project's own
+    int twoEnded = 2;                     ///< steady strokes recorded at both ends (0 = none)
 };
 
 struct SynthTruth {
