@@ -177,6 +177,21 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
 
 } // namespace
 
+ClassifierInput guettlerStrokeInput(std::vector<double> signal, double sampleRate, double f0, double beta, double z0,
+                                    double tension, double length, double accel)
+{
+    ClassifierInput in;
+    in.bridgeForce = std::move(signal);
+    in.sampleRate = sampleRate;
+    in.f0 = f0;
+    in.beta = beta;
+    in.z0 = z0;
+    in.tension = tension;
+    in.length = length;
+    in.bowSpeed = [accel](double t) { return accel * t; };
+    return in;
+}
+
 Calibration calibrateRecording(const ClassifierInput& in)
 {
     if (!(in.sampleRate > 0 && in.beta > 0 && in.tension > 0 && in.length > 0) || !in.bowSpeed)

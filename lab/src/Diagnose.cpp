@@ -58,15 +58,7 @@ double noiseLevel(const std::vector<double>& f)
 StrokeFeatures features(std::vector<double> f, double fs, double a, double F, const StringInfo& s, bool recorded = false)
 {
     zeroPhaseLowPass(f, kCompareCutoff, fs);
-    ClassifierInput in;
-    in.bridgeForce = f;
-    in.sampleRate = fs;
-    in.f0 = s.f0;
-    in.beta = s.beta;
-    in.z0 = s.z0;
-    in.tension = s.tension;
-    in.length = s.length;
-    in.bowSpeed = [a](double t) { return a * t; };
+    const ClassifierInput in = guettlerStrokeInput(f, fs, s.f0, s.beta, s.z0, s.tension, s.length, a);
     ClassifierSettings st;
     // A first slip drops the force by more than 2 % of the bow force, and in a recording by
     // clearly more than its noise can within 0.1 ms.
@@ -366,21 +358,17 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     say("preparing", 0.0);
     const std::size_t n = set.strokes.size();
     std::vector<Calibration> cal(n);
-    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+    // knownGain 0: gain fitted per recording.
+    auto recording = [&](std::size_t i, double knownGain) {
         const MeasuredStroke& s = set.strokes[i];
-        ClassifierInput in;
-        in.bridgeForce = s.signal;
-        in.sampleRate = set.sampleRate;
-        in.f0 = info.f0;
-        in.beta = info.beta;
-        in.z0 = info.z0;
-        in.tension = info.tension;
-        in.length = info.length;
-        const double a = s.accel;
-        in.bowSpeed = [a](double t) { return a * t; };
+        ClassifierInput in = guettlerStrokeInput(s.signal, set.sampleRate, info.f0, info.beta, info.z0, info.tension, info.length, s.accel);
         in.measured = true;
-        cal[i] = calibrateRecording(in);
-        if (s.trigger) cal[i].trigger = *s.trigger;
+        in.knownGain = knownGain;
+        return in;
+    };
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+        cal[i] = calibrateRecording(recording(i, 0.0));
+        if (set.strokes[i].trigger) cal[i].trigger = *set.strokes[i].trigger;
     });
     std::vector<double> gains, allGains;
     int unfitted = 0;
@@ -409,22 +397,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     // well determined even when its ramp is short.
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
         if (cal[i].firstSlip < 0) return;
-        const MeasuredStroke& s = set.strokes[i];
-        ClassifierInput in;
-        in.bridgeForce = s.signal;
-        in.sampleRate = set.sampleRate;
-        in.f0 = info.f0;
-        in.beta = info.beta;
-        in.z0 = info.z0;
-        in.tension = info.tension;
-        in.length = info.length;
-        const double a = s.accel;
-        in.bowSpeed = [a](double t) { return a * t; };
-        in.measured = true;
-        in.knownGain = set.units == "N" ? 1.0 : gain;
-        Calibration again = calibrateRecording(in);
+        Calibration again = calibrateRecording(recording(i, set.units == "N" ? 1.0 : gain));
         if (again.rampFitted) cal[i] = std::move(again);
-        if (s.trigger) cal[i].trigger = *s.trigger;
+        if (set.strokes[i].trigger) cal[i].trigger = *set.strokes[i].trigger;
     });
     std::vector<Prepared> strokes(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {

@@ -108,17 +108,9 @@ CellResult runStroke(const SweepSpec& spec, Worker& w, double a, double F, doubl
         previousFriction = fr.friction;
     }
     if (samples) *samples += static_cast<long long>(w.bridge.size());
-    ClassifierInput in;
-    in.bridgeForce = w.bridge;
+    ClassifierInput in = guettlerStrokeInput(w.bridge, fs, f0, p.beta, spec.config.string.impedance(), spec.config.string.tension,
+                                             spec.config.string.length, p.accel);
     in.stick = w.stick;
-    in.sampleRate = fs;
-    in.f0 = f0;
-    in.beta = p.beta;
-    in.z0 = spec.config.string.impedance();
-    in.tension = spec.config.string.tension;
-    in.length = spec.config.string.length;
-    const double accel = p.accel;
-    in.bowSpeed = [accel](double t) { return accel * t; };
     const Classification c = classify(in);
     r.regime = c.regime;
     r.transientPeriods = c.transientPeriods;

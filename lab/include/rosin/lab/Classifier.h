@@ -42,6 +42,10 @@ struct ClassifierInput {
     double knownGain = 0.0;
 };
 
+/// Input for a constant-acceleration (Guettler) stroke, v_b = accel * t.
+ClassifierInput guettlerStrokeInput(std::vector<double> signal, double sampleRate, double f0, double beta, double z0,
+                                    double tension, double length, double accel);
+
 struct Classification {
     Regime regime = Regime::NoSlip;
     int transientPeriods = -1;       ///< N_T, -1 for a failure
