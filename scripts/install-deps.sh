@@ -6,7 +6,7 @@ set -euo pipefail
 # Core build + dsp/lab + tests + benchmarks (always needed).
 CORE_PKGS=(
   build-essential cmake ninja-build pkg-config git
-  libsndfile1-dev libcli11-dev nlohmann-json3-dev libeigen3-dev libpng-dev
+  libsndfile1-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev
   libcairo2-dev fonts-dejavu-core          # figures (PNG) drawn by lab/
   libopenmpi-dev openmpi-bin               # Guettler sweeps over several processes/machines
