@@ -69,6 +69,7 @@ struct ModelOptions {
     double footprint = 1.0;
     bool noTorsion = false, noLosses = false, dispersion = false;
     std::string presets;
+    std::vector<std::string> overrides;
 
     void add(CLI::App* app)
     {
@@ -104,6 +105,10 @@ struct ModelOptions {
         app->add_flag("--no-losses", noLosses, "Lossless string (ideal rigid ends)");
         app->add_flag("--dispersion", dispersion, "Bending-stiffness dispersion from the string's inharmonicity B");
         app->add_option("--presets", presets, "Presets directory (default: $ROSIN_PRESETS or the source tree's presets/)");
+        app->add_option("--set", overrides, "Override a parameter, NAME=VALUE (repeatable): contact_radius_m, layer_thickness_m, "
+                                            "rosin_heat_capacity, string_effusivity, rod_effusivity, advection_width_factor, "
+                                            "reference_load_n, poles_per_decade, tension_n, length_m, torsion_speed_ratio, "
+                                            "torsion_impedance_ratio, q_low, q_high, q_torsion, inharmonicity");
     }
 
     dsp::BowedStringConfig build() const
@@ -126,6 +131,38 @@ struct ModelOptions {
         c.waveguide.torsion = !noTorsion;
         c.waveguide.losses = !noLosses;
         c.waveguide.dispersion = dispersion;
+        auto& t = c.friction.thermal;
+        auto& st = c.string;
+        const double f0 = st.fundamental();
+        const std::map<std::string, double*> fields{
+            {"contact_radius_m", &t.contactRadiusAtRef}, {"layer_thickness_m", &t.layerThickness},
+            {"rosin_heat_capacity", &t.rosinHeatCapacity}, {"string_effusivity", &t.stringEffusivity},
+            {"rod_effusivity", &t.rodEffusivity}, {"advection_width_factor", &t.advectionWidthFactor},
+            {"reference_load_n", &t.referenceLoad}, {"poles_per_decade", &t.polesPerDecade},
+            {"tension_n", &st.tension}, {"length_m", &st.length}, {"torsion_speed_ratio", &st.torsionSpeedRatio},
+            {"torsion_impedance_ratio", &st.torsionImpedanceRatio}, {"q_low", &st.qLow}, {"q_high", &st.qHigh},
+            {"q_torsion", &st.qTorsion}, {"inharmonicity", &st.inharmonicity}};
+        bool keepPitch = false;
+        for (const auto& kv : overrides) {
+            const auto eq = kv.find('=');
+            const std::string name = kv.substr(0, eq);
+            const auto it = fields.find(name);
+            if (eq == std::string::npos || it == fields.end()) throw LabError("--set: unknown parameter '" + name + "'");
+            double v = 0;
+            try {
+                std::size_t used = 0;
+                v = std::stod(kv.substr(eq + 1), &used);
+                if (used != kv.size() - eq - 1) throw std::invalid_argument("trailing");
+            } catch (const std::exception&) {
+                throw LabError("--set " + name + ": '" + kv.substr(eq + 1) + "' is not a number");
+            }
+            if (!std::isfinite(v) || v < 0 || (v == 0 && name != "inharmonicity")) throw LabError("--set " + name + ": must be a positive number");
+            *it->second = v;
+            keepPitch |= name == "tension_n" || name == "length_m";
+        }
+        // A new tension or length keeps the string's pitch: its mass per length follows.
+        if (keepPitch) st.massPerLength = st.tension / std::pow(2.0 * st.length * f0, 2.0);
+        if (const std::string problem = st.validate(); !problem.empty()) throw LabError("--set: " + problem);
         return c;
     }
 };

@@ -202,6 +202,10 @@ TEST(RosinCli, EveryGestureAndModelRenders)
             EXPECT_EQ(r.status, 0) << model << " " << gesture << ": " << r.output;
         }
     }
+    const CliRun overridden = runRosin("render --set contact_radius_m=3e-4 --set q_low=300 --set tension_n=120 --duration 0.05 "
+                                       "--no-csv --out " + (dir.path() / "o").string());
+    EXPECT_EQ(overridden.status, 0) << overridden.output;
+    EXPECT_NE(overridden.output.find("f0 146.83"), std::string::npos) << overridden.output; // pitch kept
     const CliRun hertz = runRosin("render --contact hertz --rosin bass --ambient 25 --dispersion --string violin-E" + common);
     EXPECT_EQ(hertz.status, 0) << hertz.output;
     const CliRun phrase = runRosin("render --gesture-file " + (kPresets / "gestures" / "demo-phrase.csv").string() +
@@ -231,6 +235,8 @@ TEST(RosinCli, BadArgumentsFailClearlyAndWriteNothing)
         {"render --gesture-file /nonexistent.csv" + out, "/nonexistent.csv"},
         {"render --out /nonexistent-dir/x", "/nonexistent-dir"},
         {"frobnicate", "frobnicate"},
+        {"render --set rod_effusivity=-3" + out, "--set rod_effusivity"},
+        {"render --set colour=3" + out, "unknown parameter 'colour'"},
     };
     for (const auto& [args, expected] : cases) {
         const CliRun r = runRosin(args);
