@@ -1,0 +1,168 @@
+// Pieces shared by the `rosin` commands: number validation, the model options every
+// model-building command takes, and the command registry.
+#pragma once
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "rosin/dsp.h"
+#include "rosin/lab/Error.h"
+#include "rosin/lab/Presets.h"
+
+namespace rosin::cli {
+using namespace rosin::lab;
+namespace fs = std::filesystem;
+
+/// CLI11's Range lets NaN through; every number we take must be finite and in range.
+inline CLI::Validator finiteIn(double lo, double hi)
+{
+    return CLI::Validator(
+        [lo, hi](std::string& s) -> std::string {
+            double x = 0.0;
+            try {
+                std::size_t used = 0;
+                x = std::stod(s, &used);
+                if (used != s.size()) return "'" + s + "' is not a number";
+            } catch (const std::exception&) {
+                return "'" + s + "' is not a number";
+            }
+            if (!std::isfinite(x) || x < lo || x > hi)
+                return "value " + s + " is outside " + std::to_string(lo) + ".." + std::to_string(hi);
+            return {};
+        },
+        "FLOAT in [" + CLI::detail::to_string(lo) + " - " + CLI::detail::to_string(hi) + "]");
+}
+
+/// Choices shared by every command that builds a model.
+struct ModelOptions {
+    std::string string = "cello-D";
+    std::string model = "thermal";
+    std::string fit = "auto";
+    std::string speedFunction = "rod";
+    std::string contact = "amontons";
+    double contactExponent = 2.0 / 3.0;
+    std::string rosin = "violin";
+    double ambient = 20.0;
+    double footprint = 1.0;
+    bool noTorsion = false, noLosses = false, dispersion = false;
+    std::string presets;
+    std::vector<std::string> overrides;
+
+    void add(CLI::App* app)
+    {
+        app->add_option("--string", string, "String preset id (see `rosin strings`), or FILE.json:NAME")
+            ->capture_default_str();
+        app->add_option("--model", model, "Friction model: friction-curve (mu of sliding speed), thermal (mu of "
+                                          "contact temperature), enhanced (temperature and speed)")
+            ->check(CLI::IsMember({"friction-curve", "thermal", "enhanced"}))
+            ->capture_default_str();
+        app->add_option("--fit", fit, "Steady-sliding fit the laws are built from: sw (Smith & Woodhouse "
+                                      "exponentials), wg (Woodhouse & Galluzzo power law); auto = wg for "
+                                      "the enhanced model, sw otherwise")
+            ->check(CLI::IsMember({"auto", "sw", "wg"}))
+            ->capture_default_str();
+        app->add_option("--speed-function", speedFunction, "Enhanced model only: speed function of a rosined rod or of a real bow")
+            ->check(CLI::IsMember({"rod", "bow"}))
+            ->capture_default_str();
+        app->add_option("--contact", contact, "Contact-area law: amontons (area ~ force, a bow's many "
+                                              "hairs), hertz (area ~ force^(2/3), a smooth rod), power "
+                                              "(area ~ force^n, n from --contact-exponent)")
+            ->check(CLI::IsMember({"amontons", "hertz", "power"}))
+            ->capture_default_str();
+        app->add_option("--contact-exponent", contactExponent, "Exponent n for --contact power")
+            ->check(finiteIn(0.1, 2.0));
+        app->add_option("--rosin", rosin, "Rosin preset (violin: Tg 49 C, bass: Tg 16 C) or a rosin JSON file")
+            ->capture_default_str();
+        app->add_option("--ambient", ambient, "Ambient temperature (C)")->check(finiteIn(-30.0, 60.0))->capture_default_str();
+        app->add_option("--footprint", footprint, "Footprint ratio r_A: contact area per newton relative to "
+                                                  "the steady-sliding test (thermal models)")
+            ->check(finiteIn(0.05, 20.0))
+            ->capture_default_str();
+        app->add_flag("--no-torsion", noTorsion, "Leave out torsional waves");
+        app->add_flag("--no-losses", noLosses, "Lossless string (ideal rigid ends)");
+        app->add_flag("--dispersion", dispersion, "Bending-stiffness dispersion from the string's inharmonicity B");
+        app->add_option("--presets", presets, "Presets directory (default: $ROSIN_PRESETS or the source tree's presets/)");
+        app->add_option("--set", overrides, "Override a parameter, NAME=VALUE (repeatable): contact_radius_m, layer_thickness_m, "
+                                            "rosin_heat_capacity, string_effusivity, rod_effusivity, advection_width_factor, "
+                                            "reference_load_n, poles_per_decade, tension_n, length_m, torsion_speed_ratio, "
+                                            "torsion_impedance_ratio, q_low, q_high, q_torsion, inharmonicity");
+    }
+
+    dsp::BowedStringConfig build() const
+    {
+        const fs::path dir = presetDirectory(presets);
+        dsp::BowedStringConfig c;
+        c.string = findString(dir, string).params;
+        const std::map<std::string, dsp::FrictionModel> models{{"friction-curve", dsp::FrictionModel::FrictionCurve},
+                                                               {"thermal", dsp::FrictionModel::Thermal},
+                                                               {"enhanced", dsp::FrictionModel::Enhanced}};
+        c.friction.model = models.at(model);
+        const std::string f = fit == "auto" ? (model == "enhanced" ? "wg" : "sw") : fit;
+        c.friction.fit = f == "wg" ? dsp::SteadyFit::WoodhouseGalluzzo : dsp::SteadyFit::SmithWoodhouse;
+        c.friction.speedFunction = speedFunction == "bow" ? dsp::SpeedFunction::Bow : dsp::SpeedFunction::Rod;
+        c.friction.contactLaw = contact == "amontons" ? dsp::ContactLaw::Amontons : dsp::ContactLaw::PowerLaw;
+        c.friction.contactExponent = contact == "hertz" ? 2.0 / 3.0 : contactExponent;
+        c.friction.thermal.glassTransitionCelsius = findRosin(dir, rosin).glassTransitionCelsius;
+        c.friction.thermal.ambientCelsius = ambient;
+        c.friction.thermal.footprintRatio = footprint;
+        c.waveguide.torsion = !noTorsion;
+        c.waveguide.losses = !noLosses;
+        c.waveguide.dispersion = dispersion;
+        auto& t = c.friction.thermal;
+        auto& st = c.string;
+        const double f0 = st.fundamental();
+        const std::map<std::string, double*> fields{
+            {"contact_radius_m", &t.contactRadiusAtRef}, {"layer_thickness_m", &t.layerThickness},
+            {"rosin_heat_capacity", &t.rosinHeatCapacity}, {"string_effusivity", &t.stringEffusivity},
+            {"rod_effusivity", &t.rodEffusivity}, {"advection_width_factor", &t.advectionWidthFactor},
+            {"reference_load_n", &t.referenceLoad}, {"poles_per_decade", &t.polesPerDecade},
+            {"tension_n", &st.tension}, {"length_m", &st.length}, {"torsion_speed_ratio", &st.torsionSpeedRatio},
+            {"torsion_impedance_ratio", &st.torsionImpedanceRatio}, {"q_low", &st.qLow}, {"q_high", &st.qHigh},
+            {"q_torsion", &st.qTorsion}, {"inharmonicity", &st.inharmonicity}};
+        bool keepPitch = false;
+        for (const auto& kv : overrides) {
+            const auto eq = kv.find('=');
+            const std::string name = kv.substr(0, eq);
+            const auto it = fields.find(name);
+            if (eq == std::string::npos || it == fields.end()) throw LabError("--set: unknown parameter '" + name + "'");
+            double v = 0;
+            try {
+                std::size_t used = 0;
+                v = std::stod(kv.substr(eq + 1), &used);
+                if (used != kv.size() - eq - 1) throw std::invalid_argument("trailing");
+            } catch (const std::exception&) {
+                throw LabError("--set " + name + ": '" + kv.substr(eq + 1) + "' is not a number");
+            }
+            if (!std::isfinite(v) || v < 0 || (v == 0 && name != "inharmonicity")) throw LabError("--set " + name + ": must be a positive number");
+            *it->second = v;
+            keepPitch |= name == "tension_n" || name == "length_m";
+        }
+        // A new tension or length keeps the string's pitch: its mass per length follows.
+        if (keepPitch) st.massPerLength = st.tension / std::pow(2.0 * st.length * f0, 2.0);
+        if (const std::string problem = st.validate(); !problem.empty()) throw LabError("--set: " + problem);
+        return c;
+    }
+};
+
+/// A subcommand and what runs when it is chosen (returns the exit code; may throw LabError).
+struct Command {
+    CLI::App* app;
+    std::function<int()> run;
+};
+
+Command addRenderCommand(CLI::App& app);
+Command addStringsCommand(CLI::App& app);
+Command addBenchCommand(CLI::App& app);
+Command addGuettlerCommand(CLI::App& app);
+Command addPanelCommand(CLI::App& app);
+Command addClassifyCommand(CLI::App& app);
+Command addDiagnoseCommand(CLI::App& app);
+Command addSynthDataCommand(CLI::App& app);
+Command addFiguresCommand(CLI::App& app);
+
+} // namespace rosin::cli

@@ -1,0 +1,99 @@
+// `rosin diagnose`.
+#include "Cli.h"
+
+#include <sndfile.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "rosin/lab/Bench.h"
+#include "rosin/lab/Classifier.h"
+#include "rosin/lab/Diagnose.h"
+#include "rosin/lab/Distributed.h"
+#include "rosin/lab/FigureSet.h"
+#include "rosin/lab/Figures.h"
+#include "rosin/lab/Gesture.h"
+#include "rosin/lab/Guettler.h"
+#include "rosin/lab/Measurement.h"
+#include "rosin/lab/Output.h"
+#include "rosin/lab/Render.h"
+#include "rosin/lab/Signal.h"
+#include "rosin/lab/SynthData.h"
+
+namespace rosin::cli {
+
+Command addDiagnoseCommand(CLI::App& app)
+{
+    struct State {
+        std::string diagSet, diagOut = "diagnosis";
+        DiagnoseOptions diagOptions;
+    };
+    auto st = std::make_shared<State>();
+    CLI::App* diagnoseCmd = nullptr;
+    { // registration: the options bind to the state that the handler reads
+        auto& diagSet = st->diagSet;
+        auto& diagOut = st->diagOut;
+        auto& diagOptions = st->diagOptions;
+        diagnoseCmd = app.add_subcommand("diagnose", "Compare a measurement set with the model, name what it gets wrong, "
+                                                               "extend it, and measure the gain on held-out strokes");
+        diagnoseCmd->footer("Writes OUT/diagnosis.json (shared/docs/DIAGNOSIS.md), OUT/report.md and its figures\n"
+                            "(maps.png, overlays.png, jumps.png). A broken set is refused before anything is written.");
+        diagnoseCmd->add_option("set", diagSet, "Measurement set folder (rosin-measurement/1)")->required();
+        diagnoseCmd->add_option("-o,--out", diagOut, "New output folder")->capture_default_str();
+        diagnoseCmd->add_option("--seed", diagOptions.seed, "Seed of the fit/held-out split and the bootstraps")->capture_default_str();
+        diagnoseCmd->add_option("--sim-rate", diagOptions.simRate, "Simulation rate (Hz)")->check(finiteIn(16000, 400000))->capture_default_str();
+        diagnoseCmd->add_option("--max-evaluations", diagOptions.maxEvaluations, "Model evaluations per candidate fit")->check(CLI::Range(5, 500))->capture_default_str();
+        diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
+    }
+
+    return {diagnoseCmd, [st]() -> int {
+        auto& diagSet = st->diagSet;
+        auto& diagOut = st->diagOut;
+        auto& diagOptions = st->diagOptions;
+        if (fs::exists(diagOut)) throw LabError(diagOut + ": already exists (choose a new folder)");
+        const MeasurementSet set = readMeasurementSet(diagSet);
+        Progress progress("diagnosing", !diagOptions.quiet);
+        std::string stage;
+        const Diagnosis dg = diagnose(set, diagOptions, [&](const std::string& what, double x) {
+            (void)what;
+            progress.update(x);
+        });
+        progress.finish();
+        std::string hidden = ".";
+        hidden += fs::path(diagOut).filename().string();
+        hidden += ".partial";
+        const fs::path tmp = (fs::path(diagOut).has_parent_path() ? fs::path(diagOut).parent_path() : fs::path(".")) / hidden;
+        fs::remove_all(tmp);
+        try {
+            writeDiagnosis(tmp, dg, diagOptions);
+            fs::rename(tmp, diagOut);
+        } catch (...) {
+            std::error_code ec;
+            fs::remove_all(tmp, ec);
+            throw;
+        }
+        if (!diagOptions.quiet) {
+            for (const auto& w : dg.warnings) std::printf("warning: %s\n", w.c_str());
+            for (const auto& t : dg.trials) {
+                std::printf("round %d: %-24s", t.round, t.effect.c_str());
+                for (const auto& [k, v] : t.parameters) std::printf(" %s=%.3g", k.c_str(), v);
+                std::printf("  held-out fall %.3f [%.3f, %.3f]%s\n", t.gain, t.gainLow, t.gainHigh, t.kept ? "  kept" : "");
+            }
+            if (dg.findings.empty()) std::printf("finding: none (the baseline explains the data)\n");
+            for (const auto& f : dg.findings) {
+                std::printf("finding: %s", f.effect.c_str());
+                for (const auto& [name, v] : f.parameters) std::printf("  %s = %.3g [%.3g, %.3g]", name.c_str(), v[0], v[1], v[2]);
+                std::printf("\n  %s\n", f.evidence.c_str());
+            }
+            std::printf("held-out error %.3f -> %.3f (gain %.0f %%, CI %.0f..%.0f %%); %lld simulations in %.1f s; wrote %s/\n",
+                        dg.baselineError, dg.finalError, 100 * dg.relativeGain, 100 * dg.gainLow, 100 * dg.gainHigh,
+                        dg.simulations, dg.seconds, diagOut.c_str());
+        }
+        return 0;
+    }};
+}
+
+} // namespace rosin::cli

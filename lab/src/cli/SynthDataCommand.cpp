@@ -1,0 +1,115 @@
+// `rosin synth-data`.
+#include "Cli.h"
+
+#include <sndfile.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "rosin/lab/Bench.h"
+#include "rosin/lab/Classifier.h"
+#include "rosin/lab/Diagnose.h"
+#include "rosin/lab/Distributed.h"
+#include "rosin/lab/FigureSet.h"
+#include "rosin/lab/Figures.h"
+#include "rosin/lab/Gesture.h"
+#include "rosin/lab/Guettler.h"
+#include "rosin/lab/Measurement.h"
+#include "rosin/lab/Output.h"
+#include "rosin/lab/Render.h"
+#include "rosin/lab/Signal.h"
+#include "rosin/lab/SynthData.h"
+
+namespace rosin::cli {
+
+Command addSynthDataCommand(CLI::App& app)
+{
+    struct State {
+        SynthSpec synth;
+        std::string synthOut = "set", wavKind = "pcm24";
+        std::vector<std::string> synthParams;
+        bool synthQuiet = false;
+    };
+    auto st = std::make_shared<State>();
+    CLI::App* synthCmd = nullptr;
+    { // registration: the options bind to the state that the handler reads
+        auto& synth = st->synth;
+        auto& synthOut = st->synthOut;
+        auto& wavKind = st->wavKind;
+        auto& synthParams = st->synthParams;
+        auto& synthQuiet = st->synthQuiet;
+        synthCmd = app.add_subcommand("synth-data", "Write a measurement set (rosin-measurement/1) simulated with hidden "
+                                                              "effects and a real rig's artefacts");
+        synthCmd->footer("Effects (shared/docs/DIAGNOSIS.md): thermal_memory, rate_dependence, hertzian_contact,\n"
+                         "rosin_temperature_shift, torsional_compliance; none given = the baseline (friction curve,\n"
+                         "Amontons, no torsion, reference rosin). Their parameters are drawn from the seed unless\n"
+                         "given, and written with the gain to OUT.truth.json beside the set, never inside it.");
+        synthCmd->add_option("-o,--out", synthOut, "New folder for the set (must not exist)")->capture_default_str();
+        synthCmd->add_option("--effect", synth.effects, "Hidden effect; repeat for several")->check(CLI::IsMember(effectIds()));
+        synthCmd->add_option("--param", synthParams, "Hidden parameter NAME=VALUE (r_A, h0, p, load_exponent, shift_k, zt_ratio)");
+        synthCmd->add_option("--seed", synth.seed, "Seed of parameters, jitter and artefacts")->capture_default_str();
+        synthCmd->add_option("--grid", synth.grid, "Strokes per axis of the Guettler grid")->check(CLI::Range(2, 60))->capture_default_str();
+        synthCmd->add_option("--rate", synth.outRate, "Sample rate of the files (Hz)")->check(finiteIn(8000, 384000))->capture_default_str();
+        synthCmd->add_option("--sim-rate", synth.simRate, "Rate of the simulation behind them (Hz)")->check(finiteIn(8000, 1e6))->capture_default_str();
+        synthCmd->add_option("--units", synth.units, "V (unknown gain) or N (calibrated)")->check(CLI::IsMember({"V", "N"}))->capture_default_str();
+        synthCmd->add_option("--noise", synth.noise, "White noise (N rms)")->check(finiteIn(0, 1))->capture_default_str();
+        synthCmd->add_option("--hum", synth.humHz, "Mains frequency (Hz; 0 = no hum)")->check(CLI::IsMember({"0", "50", "60"}))->capture_default_str();
+        synthCmd->add_option("--hum-level", synth.humLevel, "Hum amplitude (N)")->check(finiteIn(0, 1))->capture_default_str();
+        synthCmd->add_option("--dc", synth.dcLevel, "DC offset (N)")->check(finiteIn(-10, 10))->capture_default_str();
+        synthCmd->add_option("--trigger-max", synth.triggerMax, "Gesture starts up to this late in each file (s)")->check(finiteIn(0, 1))->capture_default_str();
+        synthCmd->add_option("--jitter", synth.jitter, "Per-stroke relative jitter of force and acceleration")->check(finiteIn(0, 0.2))->capture_default_str();
+        synthCmd->add_option("--wav", wavKind, "Sample format: pcm16, pcm24, pcm32, float, double")
+            ->check(CLI::IsMember({"pcm16", "pcm24", "pcm32", "float", "double"}))
+            ->capture_default_str();
+        synthCmd->add_flag("--gaussian-reflections", synth.gaussianReflections, "Simulate with MSW83 Gaussian-pulse reflections");
+        synthCmd->add_option("--two-ended", synth.twoEnded, "Steady strokes recorded at both string ends")->check(CLI::Range(0, 20))->capture_default_str();
+        synthCmd->add_flag("-q,--quiet", synthQuiet, "No progress and no summary");
+    }
+
+    return {synthCmd, [st]() -> int {
+        auto& synth = st->synth;
+        auto& synthOut = st->synthOut;
+        auto& wavKind = st->wavKind;
+        auto& synthParams = st->synthParams;
+        auto& synthQuiet = st->synthQuiet;
+        for (const auto& kv : synthParams) {
+            const auto eq = kv.find('=');
+            if (eq == std::string::npos) throw LabError("--param: expected NAME=VALUE, got '" + kv + "'");
+            const std::string key = kv.substr(0, eq);
+            if (key != "r_A" && key != "load_exponent" && key != "shift_k" && key != "zt_ratio" && key != "h0" && key != "p")
+                throw LabError("--param: unknown parameter '" + key + "'");
+            try {
+                synth.params[key] = std::stod(kv.substr(eq + 1));
+            } catch (const std::exception&) {
+                throw LabError("--param: '" + kv + "' has no number");
+            }
+        }
+        if (fs::exists(synthOut)) throw LabError(synthOut + ": already exists (choose a new folder)");
+        const std::map<std::string, int> formats{{"pcm16", SF_FORMAT_PCM_16}, {"pcm24", SF_FORMAT_PCM_24},
+                                                 {"pcm32", SF_FORMAT_PCM_32}, {"float", SF_FORMAT_FLOAT},
+                                                 {"double", SF_FORMAT_DOUBLE}};
+        Progress progress("synthesising", !synthQuiet);
+        SynthTruth truth;
+        const MeasurementSet set = synthesize(synth, truth, [&](double x) { progress.update(x); });
+        progress.finish();
+        OutputSet outputs;
+        const fs::path truthTmp = outputs.add(synthOut + ".truth.json");
+        {
+            nlohmann::json t{{"format", "rosin-synth-truth/1"}, {"effects", truth.effects}, {"params", truth.params},
+                             {"gain_units_per_N", truth.gain}, {"seed", synth.seed},
+                             {"triggers_s", truth.triggers}};
+            std::ofstream(truthTmp) << t.dump(1) << "\n";
+        }
+        writeMeasurementSet(synthOut, set, formats.at(wavKind));
+        outputs.commit();
+        if (!synthQuiet)
+            std::printf("wrote %s (%zu strokes at %.0f Hz, units %s) and %s.truth.json\n", synthOut.c_str(), set.strokes.size(),
+                        set.sampleRate, set.units.c_str(), synthOut.c_str());
+        return 0;
+    }};
+}
+
+} // namespace rosin::cli
