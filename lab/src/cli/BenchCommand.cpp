@@ -25,20 +25,17 @@
 
 namespace rosin::cli {
 
-Command addBenchCommand(CLI::App& app)
-{
-    struct State {
-        BenchOptions bench;
-        ModelOptions benchModel;
-        std::string precision = "float";
-    };
-    auto st = std::make_shared<State>();
-    CLI::App* benchCmd = nullptr;
-    { // registration: the options bind to the state that the handler reads
-        auto& bench = st->bench;
-        auto& benchModel = st->benchModel;
-        auto& precision = st->precision;
-        benchCmd = app.add_subcommand("bench", "Time one held note (the shared/bench/peers protocol): prints "
+namespace {
+
+/// Options of `rosin bench` (bound by add()) and what runs when it is chosen.
+struct BenchCommand {
+    BenchOptions bench;
+    ModelOptions benchModel;
+    std::string precision = "float";
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* benchCmd = app.add_subcommand("bench", "Time one held note (the shared/bench/peers protocol): prints "
                                                          "RESULT name ns_per_sample rt_factor rms");
         benchModel.string = "violin-A";
         benchModel.add(benchCmd);
@@ -54,16 +51,24 @@ Command addBenchCommand(CLI::App& app)
         benchCmd->add_option("--precision", precision, "float (plugin voice) or double (research)")
             ->check(CLI::IsMember({"float", "double"}))
             ->capture_default_str();
+        return benchCmd;
     }
 
-    return {benchCmd, [st]() -> int {
-        auto& bench = st->bench;
-        auto& benchModel = st->benchModel;
-        auto& precision = st->precision;
+    int run()
+    {
         bench.config = benchModel.build();
         bench.useFloat = precision == "float";
         return runBench(bench);
-    }};
+    }
+};
+
+} // namespace
+
+Command addBenchCommand(CLI::App& app)
+{
+    auto command = std::make_shared<BenchCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
 }
 
 } // namespace rosin::cli

@@ -83,28 +83,20 @@ int runClassify(const ModelOptions& m, const std::vector<std::string>& files, co
 
 } // namespace
 
-Command addClassifyCommand(CLI::App& app)
-{
-    struct State {
-        ModelOptions classifyModel;
-        std::vector<std::string> classifyFiles;
-        std::string classifyGesture = "guettler", classifyOut = "classify";
-        Gesture classifyG;
-        bool measured = false, classifyQuiet = false;
-        int channel = 0;
-    };
-    auto st = std::make_shared<State>();
-    CLI::App* classifyCmd = nullptr;
-    { // registration: the options bind to the state that the handler reads
-        auto& classifyModel = st->classifyModel;
-        auto& classifyFiles = st->classifyFiles;
-        auto& classifyGesture = st->classifyGesture;
-        auto& classifyOut = st->classifyOut;
-        auto& classifyG = st->classifyG;
-        auto& measured = st->measured;
-        auto& classifyQuiet = st->classifyQuiet;
-        auto& channel = st->channel;
-        classifyCmd = app.add_subcommand("classify", "Classify bow-stroke transients from bridge-force recordings or renders "
+namespace {
+
+/// Options of `rosin classify` (bound by add()) and what runs when it is chosen.
+struct ClassifyCommand {
+    ModelOptions classifyModel;
+    std::vector<std::string> classifyFiles;
+    std::string classifyGesture = "guettler", classifyOut = "classify";
+    Gesture classifyG;
+    bool measured = false, classifyQuiet = false;
+    int channel = 0;
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* classifyCmd = app.add_subcommand("classify", "Classify bow-stroke transients from bridge-force recordings or renders "
                                                                "(WAV of any format, or CSV with time_s and bridge_force_N)");
         classifyCmd->footer("Prints one line per file and writes OUT.csv and OUT.json with one record each: regime, periods to\n"
                             "Helmholtz, first-slip time, per-period labels (H Helmholtz, S double slip, F double flyback,\n"
@@ -123,19 +115,22 @@ Command addClassifyCommand(CLI::App& app)
         classifyCmd->add_option("--channel", channel, "Channel of multi-channel files (0-based)")->check(CLI::Range(0, 64));
         classifyCmd->add_option("-o,--out", classifyOut, "Output prefix: OUT.csv and OUT.json")->capture_default_str();
         classifyCmd->add_flag("-q,--quiet", classifyQuiet, "No per-file lines");
+        return classifyCmd;
     }
 
-    return {classifyCmd, [st]() -> int {
-        auto& classifyModel = st->classifyModel;
-        auto& classifyFiles = st->classifyFiles;
-        auto& classifyGesture = st->classifyGesture;
-        auto& classifyOut = st->classifyOut;
-        auto& classifyG = st->classifyG;
-        auto& measured = st->measured;
-        auto& classifyQuiet = st->classifyQuiet;
-        auto& channel = st->channel;
+    int run()
+    {
         return runClassify(classifyModel, classifyFiles, classifyGesture, classifyG, measured, channel, classifyOut, classifyQuiet);
-    }};
+    }
+};
+
+} // namespace
+
+Command addClassifyCommand(CLI::App& app)
+{
+    auto command = std::make_shared<ClassifyCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
 }
 
 } // namespace rosin::cli

@@ -25,19 +25,16 @@
 
 namespace rosin::cli {
 
-Command addDiagnoseCommand(CLI::App& app)
-{
-    struct State {
-        std::string diagSet, diagOut = "diagnosis";
-        DiagnoseOptions diagOptions;
-    };
-    auto st = std::make_shared<State>();
-    CLI::App* diagnoseCmd = nullptr;
-    { // registration: the options bind to the state that the handler reads
-        auto& diagSet = st->diagSet;
-        auto& diagOut = st->diagOut;
-        auto& diagOptions = st->diagOptions;
-        diagnoseCmd = app.add_subcommand("diagnose", "Compare a measurement set with the model, name what it gets wrong, "
+namespace {
+
+/// Options of `rosin diagnose` (bound by add()) and what runs when it is chosen.
+struct DiagnoseCommand {
+    std::string diagSet, diagOut = "diagnosis";
+    DiagnoseOptions diagOptions;
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* diagnoseCmd = app.add_subcommand("diagnose", "Compare a measurement set with the model, name what it gets wrong, "
                                                                "extend it, and measure the gain on held-out strokes");
         diagnoseCmd->footer("Writes OUT/diagnosis.json (shared/docs/DIAGNOSIS.md), OUT/report.md and its figures\n"
                             "(maps.png, overlays.png, jumps.png). A broken set is refused before anything is written.");
@@ -47,12 +44,11 @@ Command addDiagnoseCommand(CLI::App& app)
         diagnoseCmd->add_option("--sim-rate", diagOptions.simRate, "Simulation rate (Hz)")->check(finiteIn(16000, 400000))->capture_default_str();
         diagnoseCmd->add_option("--max-evaluations", diagOptions.maxEvaluations, "Model evaluations per candidate fit")->check(CLI::Range(5, 500))->capture_default_str();
         diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
+        return diagnoseCmd;
     }
 
-    return {diagnoseCmd, [st]() -> int {
-        auto& diagSet = st->diagSet;
-        auto& diagOut = st->diagOut;
-        auto& diagOptions = st->diagOptions;
+    int run()
+    {
         if (fs::exists(diagOut)) throw LabError(diagOut + ": already exists (choose a new folder)");
         const MeasurementSet set = readMeasurementSet(diagSet);
         Progress progress("diagnosing", !diagOptions.quiet);
@@ -93,7 +89,16 @@ Command addDiagnoseCommand(CLI::App& app)
                         dg.simulations, dg.seconds, diagOut.c_str());
         }
         return 0;
-    }};
+    }
+};
+
+} // namespace
+
+Command addDiagnoseCommand(CLI::App& app)
+{
+    auto command = std::make_shared<DiagnoseCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
 }
 
 } // namespace rosin::cli

@@ -91,18 +91,16 @@ int runGuettler(const ModelOptions& m, const GuettlerCli& g)
 
 } // namespace
 
-Command addGuettlerCommand(CLI::App& app)
-{
-    struct State {
-        ModelOptions guettlerModel;
-        GuettlerCli gcli;
-    };
-    auto st = std::make_shared<State>();
-    CLI::App* guettlerCmd = nullptr;
-    { // registration: the options bind to the state that the handler reads
-        auto& guettlerModel = st->guettlerModel;
-        auto& gcli = st->gcli;
-        guettlerCmd = app.add_subcommand("guettler", "Guettler diagram: a constant-acceleration stroke from rest for every "
+namespace {
+
+/// Options of `rosin guettler` (bound by add()) and what runs when it is chosen.
+struct GuettlerCommand {
+    ModelOptions guettlerModel;
+    GuettlerCli gcli;
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* guettlerCmd = app.add_subcommand("guettler", "Guettler diagram: a constant-acceleration stroke from rest for every "
                                                                "(acceleration, force) cell, classified; table (CSV, JSON) and PNG");
         guettlerCmd->footer("Colours: light = Helmholtz soon after the first slip, dark = late (25 periods); blue double slip,\n"
                             "cyan double flyback, red irregular, black no slip; a dot marks S-motion. Dashed lines: Guettler's\n"
@@ -130,15 +128,24 @@ Command addGuettlerCommand(CLI::App& app)
         guettlerCmd->add_flag("--no-bounds", gcli.noBounds, "Leave out Guettler's theoretical bounds");
         guettlerCmd->add_flag("--no-fit", gcli.noFit, "Leave out the fitted lower boundary");
         guettlerCmd->add_flag("-q,--quiet", gcli.quiet, "No progress and no summary");
+        return guettlerCmd;
     }
 
-    return {guettlerCmd, [st]() -> int {
-        auto& guettlerModel = st->guettlerModel;
-        auto& gcli = st->gcli;
+    int run()
+    {
         if (gcli.aMin > gcli.aMax) throw LabError("--accel-min must not exceed --accel-max");
         if (gcli.fMin > gcli.fMax) throw LabError("--force-min must not exceed --force-max");
         return runGuettler(guettlerModel, gcli);
-    }};
+    }
+};
+
+} // namespace
+
+Command addGuettlerCommand(CLI::App& app)
+{
+    auto command = std::make_shared<GuettlerCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
 }
 
 } // namespace rosin::cli

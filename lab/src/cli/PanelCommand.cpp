@@ -25,32 +25,26 @@
 
 namespace rosin::cli {
 
-Command addPanelCommand(CLI::App& app)
-{
-    struct State {
-        std::vector<std::string> panelFiles, panelTitles;
-        std::string panelOut = "panel.png";
-        int panelColumns = 2;
-    };
-    auto st = std::make_shared<State>();
-    CLI::App* panelCmd = nullptr;
-    { // registration: the options bind to the state that the handler reads
-        auto& panelFiles = st->panelFiles;
-        auto& panelTitles = st->panelTitles;
-        auto& panelOut = st->panelOut;
-        auto& panelColumns = st->panelColumns;
-        panelCmd = app.add_subcommand("panel", "Lay out Guettler diagrams from earlier `rosin guettler` tables side by side");
+namespace {
+
+/// Options of `rosin panel` (bound by add()) and what runs when it is chosen.
+struct PanelCommand {
+    std::vector<std::string> panelFiles, panelTitles;
+    std::string panelOut = "panel.png";
+    int panelColumns = 2;
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* panelCmd = app.add_subcommand("panel", "Lay out Guettler diagrams from earlier `rosin guettler` tables side by side");
         panelCmd->add_option("tables", panelFiles, "JSON tables written by rosin guettler")->required()->check(CLI::ExistingFile);
         panelCmd->add_option("--title", panelTitles, "Title per diagram, in order (default: the model)");
         panelCmd->add_option("--columns", panelColumns, "Diagrams per row")->check(CLI::Range(1, 8))->capture_default_str();
         panelCmd->add_option("-o,--out", panelOut, "PNG to write")->capture_default_str();
+        return panelCmd;
     }
 
-    return {panelCmd, [st]() -> int {
-        auto& panelFiles = st->panelFiles;
-        auto& panelTitles = st->panelTitles;
-        auto& panelOut = st->panelOut;
-        auto& panelColumns = st->panelColumns;
+    int run()
+    {
         std::vector<SweepResult> sweeps;
         for (const auto& f : panelFiles) sweeps.push_back(readSweepJson(f));
         OutputSet outputs;
@@ -59,7 +53,16 @@ Command addPanelCommand(CLI::App& app)
         outputs.commit();
         std::printf("wrote %s (%zu diagrams)\n", panelOut.c_str(), sweeps.size());
         return 0;
-    }};
+    }
+};
+
+} // namespace
+
+Command addPanelCommand(CLI::App& app)
+{
+    auto command = std::make_shared<PanelCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
 }
 
 } // namespace rosin::cli

@@ -75,29 +75,19 @@ int runRender(const ModelOptions& m, const std::string& gestureName, const Gestu
 
 } // namespace
 
-Command addRenderCommand(CLI::App& app)
-{
-    struct State {
-        ModelOptions renderModel;
-        std::string gestureName = "guettler", gestureFile, out = "rosin-render";
-        Gesture gesture;
-        double duration = 0.0, sampleRate = 192000.0;
-        bool noCsv = false, listen = false, quiet = false;
-    };
-    auto st = std::make_shared<State>();
-    CLI::App* renderCmd = nullptr;
-    { // registration: the options bind to the state that the handler reads
-        auto& renderModel = st->renderModel;
-        auto& gestureName = st->gestureName;
-        auto& gestureFile = st->gestureFile;
-        auto& out = st->out;
-        auto& gesture = st->gesture;
-        auto& duration = st->duration;
-        auto& sampleRate = st->sampleRate;
-        auto& noCsv = st->noCsv;
-        auto& listen = st->listen;
-        auto& quiet = st->quiet;
-        renderCmd = app.add_subcommand("render", "Simulate one bow gesture; write the bridge force as WAV and "
+namespace {
+
+/// Options of `rosin render` (bound by add()) and what runs when it is chosen.
+struct RenderCommand {
+    ModelOptions renderModel;
+    std::string gestureName = "guettler", gestureFile, out = "rosin-render";
+    Gesture gesture;
+    double duration = 0.0, sampleRate = 192000.0;
+    bool noCsv = false, listen = false, quiet = false;
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* renderCmd = app.add_subcommand("render", "Simulate one bow gesture; write the bridge force as WAV and "
                                                            "every simulated quantity as CSV");
         renderCmd->footer(
             "Gestures (PHYSICS.md 6.1):\n"
@@ -134,21 +124,22 @@ Command addRenderCommand(CLI::App& app)
         renderCmd->add_flag("--no-csv", noCsv, "Write only the WAV");
         renderCmd->add_flag("--listen", listen, "Normalised 24-bit WAV for listening instead of newtons");
         renderCmd->add_flag("-q,--quiet", quiet, "No progress and no summary");
+        return renderCmd;
     }
 
-    return {renderCmd, [st]() -> int {
-        auto& renderModel = st->renderModel;
-        auto& gestureName = st->gestureName;
-        auto& gestureFile = st->gestureFile;
-        auto& out = st->out;
-        auto& gesture = st->gesture;
-        auto& duration = st->duration;
-        auto& sampleRate = st->sampleRate;
-        auto& noCsv = st->noCsv;
-        auto& listen = st->listen;
-        auto& quiet = st->quiet;
+    int run()
+    {
         return runRender(renderModel, gestureName, gesture, gestureFile, duration, sampleRate, out, noCsv, listen, quiet);
-    }};
+    }
+};
+
+} // namespace
+
+Command addRenderCommand(CLI::App& app)
+{
+    auto command = std::make_shared<RenderCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
 }
 
 } // namespace rosin::cli

@@ -25,21 +25,21 @@
 
 namespace rosin::cli {
 
-Command addStringsCommand(CLI::App& app)
-{
-    struct State {
-        std::string stringsPresets;
-    };
-    auto st = std::make_shared<State>();
-    CLI::App* stringsCmd = nullptr;
-    { // registration: the options bind to the state that the handler reads
-        auto& stringsPresets = st->stringsPresets;
-        stringsCmd = app.add_subcommand("strings", "List the string presets with their physical constants");
+namespace {
+
+/// Options of `rosin strings` (bound by add()) and what runs when it is chosen.
+struct StringsCommand {
+    std::string stringsPresets;
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* stringsCmd = app.add_subcommand("strings", "List the string presets with their physical constants");
         stringsCmd->add_option("--presets", stringsPresets, "Presets directory");
+        return stringsCmd;
     }
 
-    return {stringsCmd, [st]() -> int {
-        auto& stringsPresets = st->stringsPresets;
+    int run()
+    {
         std::printf("%-16s %-5s %9s %7s %7s %9s %8s %8s\n", "id", "note", "f0 (Hz)", "L (m)", "T (N)", "m (g/m)",
                     "Z0 (kg/s)", "c (m/s)");
         for (const auto& p : loadAllStrings(presetDirectory(stringsPresets))) {
@@ -48,7 +48,16 @@ Command addStringsCommand(CLI::App& app)
                         q.fundamental(), q.length, q.tension, 1e3 * q.massPerLength, q.impedance(), q.waveSpeed());
         }
         return 0;
-    }};
+    }
+};
+
+} // namespace
+
+Command addStringsCommand(CLI::App& app)
+{
+    auto command = std::make_shared<StringsCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
 }
 
 } // namespace rosin::cli

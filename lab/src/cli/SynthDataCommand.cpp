@@ -25,23 +25,18 @@
 
 namespace rosin::cli {
 
-Command addSynthDataCommand(CLI::App& app)
-{
-    struct State {
-        SynthSpec synth;
-        std::string synthOut = "set", wavKind = "pcm24";
-        std::vector<std::string> synthParams;
-        bool synthQuiet = false;
-    };
-    auto st = std::make_shared<State>();
-    CLI::App* synthCmd = nullptr;
-    { // registration: the options bind to the state that the handler reads
-        auto& synth = st->synth;
-        auto& synthOut = st->synthOut;
-        auto& wavKind = st->wavKind;
-        auto& synthParams = st->synthParams;
-        auto& synthQuiet = st->synthQuiet;
-        synthCmd = app.add_subcommand("synth-data", "Write a measurement set (rosin-measurement/1) simulated with hidden "
+namespace {
+
+/// Options of `rosin synth-data` (bound by add()) and what runs when it is chosen.
+struct SynthDataCommand {
+    SynthSpec synth;
+    std::string synthOut = "set", wavKind = "pcm24";
+    std::vector<std::string> synthParams;
+    bool synthQuiet = false;
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* synthCmd = app.add_subcommand("synth-data", "Write a measurement set (rosin-measurement/1) simulated with hidden "
                                                               "effects and a real rig's artefacts");
         synthCmd->footer("Effects (shared/docs/DIAGNOSIS.md): thermal_memory, rate_dependence, hertzian_contact,\n"
                          "rosin_temperature_shift, torsional_compliance; none given = the baseline (friction curve,\n"
@@ -67,14 +62,11 @@ Command addSynthDataCommand(CLI::App& app)
         synthCmd->add_flag("--gaussian-reflections", synth.gaussianReflections, "Simulate with MSW83 Gaussian-pulse reflections");
         synthCmd->add_option("--two-ended", synth.twoEnded, "Steady strokes recorded at both string ends")->check(CLI::Range(0, 20))->capture_default_str();
         synthCmd->add_flag("-q,--quiet", synthQuiet, "No progress and no summary");
+        return synthCmd;
     }
 
-    return {synthCmd, [st]() -> int {
-        auto& synth = st->synth;
-        auto& synthOut = st->synthOut;
-        auto& wavKind = st->wavKind;
-        auto& synthParams = st->synthParams;
-        auto& synthQuiet = st->synthQuiet;
+    int run()
+    {
         for (const auto& kv : synthParams) {
             const auto eq = kv.find('=');
             if (eq == std::string::npos) throw LabError("--param: expected NAME=VALUE, got '" + kv + "'");
@@ -109,7 +101,16 @@ Command addSynthDataCommand(CLI::App& app)
             std::printf("wrote %s (%zu strokes at %.0f Hz, units %s) and %s.truth.json\n", synthOut.c_str(), set.strokes.size(),
                         set.sampleRate, set.units.c_str(), synthOut.c_str());
         return 0;
-    }};
+    }
+};
+
+} // namespace
+
+Command addSynthDataCommand(CLI::App& app)
+{
+    auto command = std::make_shared<SynthDataCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
 }
 
 } // namespace rosin::cli
