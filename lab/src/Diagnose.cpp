@@ -294,8 +294,7 @@ std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const st
 }
 
 std::string describe(const std::string& effect, const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after,
-                     const std::vector<Prepared>& strokes, const std::vector<std::size_t>& ids, const EffectModel& from,
-                     double errBefore, double errAfter)
+                     const std::vector<std::size_t>& ids, const EffectModel& from, double errBefore, double errAfter)
 {
     // The part of the comparison the extension mended most, weighted as in the metric.
     const char* names[] = {"first-slip times", "bridge forces before the first slip", "first-slip jumps", "transient lengths",
@@ -324,7 +323,6 @@ std::string describe(const std::string& effect, const std::vector<ErrorParts>& b
                   "when %s. Held-out error %.3f -> %.3f.",
                   from.name().c_str(), names[top], ids.size(), 100.0 * b[top] / m, unit[top], 100.0 * a[top] / m,
                   meaning.at(effect).c_str(), errBefore, errAfter);
-    (void)strokes;
     return buf;
 }
 
@@ -382,6 +380,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         // The ramp gives the gain only once the string is quasi-statically deflected.
         if (cal[i].firstSlip / set.sampleRate - cal[i].trigger > 4.0 / info.f0) gains.push_back(cal[i].gain);
     }
+    // The gesture starts were estimated, not taken as the file starts, when any ramp fitted.
+    d.triggersDetected = !allGains.empty();
     if (unfitted > 0)
         d.warnings.push_back(std::to_string(unfitted) + " stroke(s) slipped before a pre-slip ramp could be fitted: their gesture start is taken as the file start");
     double gain = median(gains.size() >= 3 ? gains : allGains);
@@ -543,7 +543,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 }
             finding.heldoutBefore = before;
             finding.heldoutAfter = Engine::mean(currentHeld);
-            finding.evidence = describe(effect, stepBefore, currentHeld, strokes, held, from, before, finding.heldoutAfter);
+            finding.evidence = describe(effect, stepBefore, currentHeld, held, from, before, finding.heldoutAfter);
             d.findings.push_back(std::move(finding));
         }
     }

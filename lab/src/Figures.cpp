@@ -38,7 +38,7 @@ void drawGuettler(Canvas& canvas, double left, double top, double width, double 
     const auto& A = r.spec.accelerations;
     const auto& F = r.spec.forces;
     const double da = A.size() > 1 ? A[1] - A[0] : A[0], dF = F.size() > 1 ? F[1] - F[0] : F[0];
-    const double aMin = A.front() - da / 2, aMax = A.back() + da / 2, fMin = F.front() - dF / 2, fMax = F.back() + dF / 2;
+    const double aMax = A.back() + da / 2, fMax = F.back() + dF / 2;
     Axes ax(canvas, left, top, width, height, 0.0, aMax, 0.0, fMax);
     for (std::size_t ia = 0; ia < A.size(); ++ia)
         for (std::size_t iF = 0; iF < F.size(); ++iF) {
@@ -47,8 +47,6 @@ void drawGuettler(Canvas& canvas, double left, double top, double width, double 
             ax.rect(A[ia] - da / 2, F[iF] - dF / 2, A[ia] + da / 2, F[iF] + dF / 2, col);
             if (c.regime == Regime::SMotion) ax.points({A[ia]}, {F[iF]}, colors::black, 1.6);
         }
-    (void)aMin;
-    (void)fMin;
     std::vector<std::pair<std::string, Color>> legend;
     if (o.bounds) {
         const GuettlerBounds b = guettlerBounds(r.spec.config.string, r.spec.betas[ib], o.muS, o.muD);

@@ -52,11 +52,7 @@ struct DiagnoseCommand {
         if (fs::exists(diagOut)) throw LabError(diagOut + ": already exists (choose a new folder)");
         const MeasurementSet set = readMeasurementSet(diagSet);
         Progress progress("diagnosing", !diagOptions.quiet);
-        std::string stage;
-        const Diagnosis dg = diagnose(set, diagOptions, [&](const std::string& what, double x) {
-            (void)what;
-            progress.update(x);
-        });
+        const Diagnosis dg = diagnose(set, diagOptions, [&](const std::string&, double x) { progress.update(x); });
         progress.finish();
         std::string hidden = ".";
         hidden += fs::path(diagOut).filename().string();

@@ -14,8 +14,6 @@ enum class Regime { Helmholtz, SMotion, DoubleSlip, DoubleFlyback, Irregular, No
 const char* regimeName(Regime r);
 bool isSuccess(Regime r); ///< Helmholtz or S-motion within the cap
 
-enum class PeriodLabel : char { H = 'H', DoubleSlip = 'S', DoubleFlyback = 'F', Irregular = 'X' };
-
 struct ClassifierSettings {
     double flybackFraction = 0.35;  ///< gamma: a flyback drops more than gamma * 2 Z0 vb / beta
     int capPeriods = 25;            ///< transients longer than this are failures [WG25; GW14]
@@ -57,7 +55,7 @@ struct Classification {
     double triggerTime = 0;          ///< s into the record where the gesture starts
     double humFrequency = 0;         ///< 50 or 60 Hz when hum was removed, else 0
     std::vector<double> flybacks;    ///< s from the gesture start
-    std::string labels;              ///< one character per period from the first slip
+    std::string labels;              ///< per period from the first slip: H Helmholtz, S double slip, F double flyback, X irregular
     int sMotionPeriods = 0;
 };
 

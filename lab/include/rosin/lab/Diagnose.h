@@ -85,7 +85,7 @@ struct Diagnosis {
     std::size_t nFit = 0, nHeldout = 0;
     std::vector<std::string> fitIds, heldoutIds;
     double scale = 1.0;         ///< N per signal unit
-    bool triggersDetected = true;
+    bool triggersDetected = false; ///< gesture starts estimated from pre-slip ramps
     std::vector<std::string> warnings;
     double seconds = 0;
     long long simulations = 0;
