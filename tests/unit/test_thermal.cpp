@@ -161,3 +161,59 @@ TEST(ContactArea, HertzAndAmontonsAgreeAtTheReferenceLoad)
     EXPECT_NEAR(a.area(tp.referenceLoad), h.area(tp.referenceLoad), 1e-18);
     EXPECT_NEAR(a.area(1.0), std::numbers::pi * 250e-6 * 250e-6, 1e-15);
 }
+
+// reset() must leave no trace of earlier strokes: a reset voice repeats a fresh one exactly.
+TEST(ThermalModel, ResetVoiceRepeatsAFreshOneExactly)
+{
+    BowedStringConfig c;
+    c.friction.model = FrictionModel::Thermal;
+    const double fs = 48000.0;
+    auto stroke = [&](BowedString<double>& s) {
+        std::vector<double> out;
+        for (int n = 0; n < 12000; ++n) out.push_back(s.processSample(0.9, 1.3 * n / fs, 0.0899));
+        return out;
+    };
+    BowedString<double> fresh, reused;
+    fresh.prepare(fs, c);
+    reused.prepare(fs, c);
+    for (int n = 0; n < 20000; ++n) reused.processSample(1.7, 0.3, 0.12); // another stroke first
+    reused.reset();
+    EXPECT_EQ(stroke(reused), stroke(fresh));
+}
+
+// prepare() with a new contact law must not reuse the effective load cached under the old one.
+TEST(ContactArea, RepreparingWithAnotherExponentForgetsTheCachedLoad)
+{
+    BowedStringConfig a, b;
+    a.friction.contactLaw = b.friction.contactLaw = ContactLaw::PowerLaw;
+    a.friction.contactExponent = 0.6;
+    b.friction.contactExponent = 0.9;
+    const double fs = 48000.0;
+    auto stroke = [&](BowedString<double>& s) {
+        std::vector<double> out;
+        for (int n = 0; n < 6000; ++n) out.push_back(s.processSample(2.0, 1.5 * n / fs, 0.0899));
+        return out;
+    };
+    BowedString<double> fresh, reprepared;
+    fresh.prepare(fs, b);
+    reprepared.prepare(fs, a);
+    stroke(reprepared); // caches the load of 2 N under exponent 0.6
+    reprepared.prepare(fs, b);
+    EXPECT_EQ(stroke(reprepared), stroke(fresh));
+}
+
+// The 2 % rule of setKappa must not reach across a reset: a kappa within 2 % of the one before
+// the reset gets its own coefficients, as in a fresh bank.
+TYPED_TEST(ConductionBankTest, ResetForgetsTheLastKappa)
+{
+    ThermalParams tp;
+    ConductionBank<TypeParam> used, fresh;
+    used.prepare(48000.0, tp.xiMin, tp.xiMaxOverSampleRate * 48000.0, tp.polesPerDecade);
+    fresh.prepare(48000.0, tp.xiMin, tp.xiMaxOverSampleRate * 48000.0, tp.polesPerDecade);
+    used.setKappa(1000.0);
+    used.advance(TypeParam(1));
+    used.reset();
+    used.setKappa(1015.0);
+    fresh.setKappa(1015.0);
+    EXPECT_EQ(used.gamma(), fresh.gamma());
+}

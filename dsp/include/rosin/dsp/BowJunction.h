@@ -53,6 +53,8 @@ public:
         if (params.model == FrictionModel::Enhanced) law_.build(params.fit, std::optional<SpeedLaw>(speed_), params.thermal);
         thermal_.prepare(sampleRate, params.thermal);
         muAtRest_ = speedLaw(0.0).mu;
+        forceCached_ = -1.0; // the load for a force depends on the contact law just configured
+        zEffCached_ = -1.0;
         reset();
     }
 

@@ -62,6 +62,10 @@ public:
     {
         for (Pack& z : z_) z = Pack{};
         thetaPrev_ = 0.0;
+        // The 2 % rule of setKappa remembers the last kappa: forget it, so a reset bank
+        // behaves exactly like a freshly prepared one.
+        kappa_ = -1.0;
+        setKappa(0.0);
     }
 
     /// [audio thread] Surface-renewal rate (1/s). Coefficients are recomputed only when it moves
