@@ -1,10 +1,12 @@
 #include "rosin/lab/Diagnose.h"
 
 #include <nlopt.hpp>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -105,12 +107,21 @@ public:
     /// Simulated features of stroke i under model m (optionally the first 12 periods of force).
     StrokeFeatures simulate(const EffectModel& m, std::size_t i, std::vector<double>* head = nullptr) const
     {
-        dsp::BowedStringConfig c = modelWithEffects(m.effects, m.params);
-        c.string.length = info_.length;
-        c.string.tension = info_.tension;
-        c.string.massPerLength = info_.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
-        dsp::BowedString<double> s;
-        s.prepare(fs_, c);
+        // One prepared voice per thread, kept while the model stays the same (all the strokes of
+        // one evaluation): reset() restores it exactly, prepare() would rebuild its tables.
+        Voice& v = voices_.local();
+        if (!v.string || v.model.effects != m.effects || v.model.params != m.params) {
+            dsp::BowedStringConfig c = modelWithEffects(m.effects, m.params);
+            c.string.length = info_.length;
+            c.string.tension = info_.tension;
+            c.string.massPerLength = info_.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
+            if (!v.string) v.string = std::make_unique<dsp::BowedString<double>>();
+            v.string->prepare(fs_, c);
+            v.model = m;
+        } else {
+            v.string->reset();
+        }
+        dsp::BowedString<double>& s = *v.string;
         const Prepared& p = strokes_[i];
         std::vector<double> out(p.force.size());
         for (std::size_t n = 0; n < out.size(); ++n) out[n] = s.processSample(p.F, p.a * static_cast<double>(n) / fs_, info_.beta);
@@ -139,10 +150,15 @@ public:
     long long simulations() const { return simulations_.load(); }
 
 private:
+    struct Voice {
+        EffectModel model;
+        std::unique_ptr<dsp::BowedString<double>> string;
+    };
     std::vector<Prepared>& strokes_;
     StringInfo info_;
     double fs_;
     mutable std::atomic<long long> simulations_{0};
+    mutable tbb::enumerable_thread_specific<Voice> voices_;
 };
 
 struct Candidate {
