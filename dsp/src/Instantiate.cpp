@@ -15,4 +15,6 @@ template class BowJunction<float>;
 template class BowJunction<double>;
 template class BowedString<float>;
 template class BowedString<double>;
+template class ModalBody<float>;
+template class ModalBody<double>;
 } // namespace rosin::dsp

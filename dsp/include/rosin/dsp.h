@@ -1,5 +1,6 @@
 // Umbrella header of the real-time model library.
 #pragma once
+#include "rosin/dsp/Body.h"
 #include "rosin/dsp/BowJunction.h"
 #include "rosin/dsp/BowedString.h"
 #include "rosin/dsp/Config.h"

@@ -28,6 +28,10 @@ struct FrictionParams {
     ContactLaw contactLaw = ContactLaw::Amontons;
     double contactExponent = 2.0 / 3.0;
     ThermalParams thermal;
+    /// Build the temperature laws of both thermal models in prepare(), so setModel() can switch
+    /// between all three on the audio thread (a playable instrument); off for sweeps, which
+    /// fix the model and would pay for a table they never read.
+    bool switchable = false;
 };
 
 enum class ContactState { Stick, SlipForward, SlipBackward };
@@ -48,9 +52,12 @@ public:
     {
         params_ = params;
         area_.configure(params.contactLaw, params.contactExponent, params.thermal);
-        if (params.model == FrictionModel::Thermal) law_.build(params.fit, std::nullopt, params.thermal);
         speed_ = params.effectiveSpeedLaw();
-        if (params.model == FrictionModel::Enhanced) law_.build(params.fit, std::optional<SpeedLaw>(speed_), params.thermal);
+        const bool both = params.switchable;
+        if (both || params.model == FrictionModel::Thermal) thermalLaw_.build(params.fit, std::nullopt, params.thermal);
+        if (both || params.model == FrictionModel::Enhanced)
+            enhancedLaw_.build(params.fit, std::optional<SpeedLaw>(speed_), params.thermal);
+        applyShiftAndScale();
         thermal_.prepare(sampleRate, params.thermal);
         muAtRest_ = speedLaw(0.0).mu;
         forceCached_ = -1.0; // the load for a force depends on the contact law just configured
@@ -61,8 +68,51 @@ public:
     /// [audio thread] Ambient temperature (C) without rebuilding the temperature law.
     void setAmbient(double celsius) noexcept
     {
+        if (!std::isfinite(celsius) || celsius == params_.thermal.ambientCelsius) return;
         params_.thermal.ambientCelsius = celsius;
-        law_.setShift(params_.thermal.temperatureShift());
+        applyShiftAndScale();
+    }
+
+    /// [audio thread] A softer or harder rosin: its glass transition (C) shifts the law.
+    void setGlassTransition(double celsius) noexcept
+    {
+        if (!std::isfinite(celsius) || celsius == params_.thermal.glassTransitionCelsius) return;
+        params_.thermal.glassTransitionCelsius = celsius;
+        applyShiftAndScale();
+    }
+
+    /// [audio thread] Footprint ratio r_A (bow / steady test): scales the temperature law.
+    void setFootprintRatio(double ratio) noexcept
+    {
+        if (!(ratio > 0.0) || !std::isfinite(ratio) || ratio == params_.thermal.footprintRatio) return;
+        params_.thermal.footprintRatio = ratio;
+        applyShiftAndScale();
+    }
+
+    /// [audio thread] Amontons or power-law contact; the contact temperature carries on.
+    void setContactLaw(ContactLaw law, double exponent) noexcept
+    {
+        if (law == params_.contactLaw && exponent == params_.contactExponent) return;
+        if (!(exponent > 0.0 && exponent <= 1.0)) return;
+        params_.contactLaw = law;
+        params_.contactExponent = exponent;
+        area_.configure(law, exponent, params_.thermal);
+        forceCached_ = -1.0;
+    }
+
+    /// [audio thread] Switch the friction model. The thermal models need their table from
+    /// prepare() (FrictionParams::switchable); a request for a missing one is ignored and
+    /// reported false. Heat state carries over, so a switch mid-note does not restart the note.
+    bool setModel(FrictionModel model) noexcept
+    {
+        if (model == params_.model) return true;
+        if (model == FrictionModel::Thermal && !thermalLaw_.built()) return false;
+        if (model == FrictionModel::Enhanced && !enhancedLaw_.built()) return false;
+        params_.model = model;
+        muAtRest_ = speedLaw(0.0).mu; // the jump rule's static limit follows the model's speed law
+        applyShiftAndScale();
+        if (model == FrictionModel::Thermal && state_ != ContactState::Stick) xPrev_ = 0.0;
+        return true;
     }
 
     /// [audio thread] Relative noise on the friction force while slipping (0 = off), from a
@@ -112,11 +162,11 @@ public:
             theta = thermal_.step(heatPerLoadPrev_ * load, slidePrev_, area_.areaPerNewton * load, heatSlopePerLoadPrev_ * load);
 
         if (params_.model == FrictionModel::Thermal) {
-            const double limit = load * law_(theta);
+            const double limit = load * law()(theta);
             if (std::abs(fStick) <= limit) { f = fStick; state_ = ContactState::Stick; }
             else { f = side * limit; state_ = side > 0 ? ContactState::SlipForward : ContactState::SlipBackward; }
         } else {
-            const double scale = params_.model == FrictionModel::Enhanced ? law_(theta) : 1.0;
+            const double scale = params_.model == FrictionModel::Enhanced ? law()(theta) : 1.0;
             f = solveWithJumpRule(D, fStick, load, scale, twoZ);
         }
         if (noiseLevel_ > 0.0 && state_ != ContactState::Stick) f *= 1.0 + noiseLevel_ * nextNoise();
@@ -126,9 +176,9 @@ public:
         slidePrev_ = dv;
         // d(heat)/d(theta) per unit load at fixed sliding speed, for the semi-implicit step.
         heatSlopePerLoadPrev_ = 0.0;
-        if (dv > 0.0 && params_.model == FrictionModel::Thermal) heatSlopePerLoadPrev_ = dv * law_.slope(theta);
+        if (dv > 0.0 && params_.model == FrictionModel::Thermal) heatSlopePerLoadPrev_ = dv * law().slope(theta);
         if (dv > 0.0 && params_.model == FrictionModel::Enhanced)
-            heatSlopePerLoadPrev_ = dv * speed_(dv).mu * law_.slope(theta);
+            heatSlopePerLoadPrev_ = dv * speed_(dv).mu * law().slope(theta);
         return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), state_ == ContactState::Stick};
     }
 
@@ -139,8 +189,8 @@ public:
         const double load = area_.effectiveLoad(fb);
         switch (params_.model) {
         case FrictionModel::FrictionCurve: return load * steadySliding(params_.fit, 0.0).mu;
-        case FrictionModel::Thermal: return load * law_(theta);
-        case FrictionModel::Enhanced: return load * law_(theta) * speed_(0.0).mu;
+        case FrictionModel::Thermal: return load * law()(theta);
+        case FrictionModel::Enhanced: return load * law()(theta) * speed_(0.0).mu;
         }
         return 0.0;
     }
@@ -153,12 +203,27 @@ public:
 
     ContactState state() const noexcept { return state_; }
     double temperature() const noexcept { return thermal_.temperature(); }
-    const TemperatureLaw& temperatureLaw() const noexcept { return law_; }
+    const TemperatureLaw& temperatureLaw() const noexcept { return law(); }
     const ContactArea& contactArea() const noexcept { return area_; }
     const FrictionParams& params() const noexcept { return params_; }
     ThermalContact<T>& thermal() noexcept { return thermal_; }
 
 private:
+    /// The table the current model reads (an index, not a pointer, so copies stay valid).
+    const TemperatureLaw& law() const noexcept
+    {
+        return params_.model == FrictionModel::Enhanced ? enhancedLaw_ : thermalLaw_;
+    }
+
+
+    void applyShiftAndScale() noexcept
+    {
+        for (auto* law : {&thermalLaw_, &enhancedLaw_}) {
+            law->setShift(params_.thermal.temperatureShift());
+            law->setScale(params_.thermal.footprintRatio);
+        }
+    }
+
     /// Uniform in [-1, 1) from xorshift64*: cheap, seeded, the same on every platform.
     double nextNoise() noexcept
     {
@@ -238,7 +303,7 @@ private:
 
     FrictionParams params_;
     ContactArea area_;
-    TemperatureLaw law_;
+    TemperatureLaw thermalLaw_, enhancedLaw_;
     ThermalContact<T> thermal_;
     ContactState state_ = ContactState::Stick;
     double xPrev_ = 0.0, heatPerLoadPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePerLoadPrev_ = 0.0;

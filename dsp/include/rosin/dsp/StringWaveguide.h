@@ -27,6 +27,9 @@ struct WaveguideOptions {
     /// MSW83 Gaussian-pulse reflections instead of one-pole loss + Lagrange delay (a second,
     /// independent design: data simulated with it tests that analysis does not depend on ours).
     bool gaussianReflections = false;
+    /// Lowest fundamental the delay lines must hold, as a fraction of the open string's: a
+    /// playable voice bends below the open pitch; research runs keep 1.
+    double lowestPitchRatio = 1.0;
 };
 
 template <typename T>
@@ -44,9 +47,11 @@ public:
         w0_ = 2.0 * std::numbers::pi * f0_ / fs_;
         fLossProbe_ = std::min(5.0 * f0_, 0.4 * fs_);
         wLossProbe_ = 2.0 * std::numbers::pi * fLossProbe_ / fs_;
-        const double period = fs_ / f0_;
+        const double ratio = std::clamp(options.lowestPitchRatio, 0.05, 1.0);
+        const double period = fs_ / (f0_ * ratio);
+        lowestFundamental_ = f0_ * ratio;
         for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_})
-            line->prepare(period + 16.0);
+            line->prepare(period / std::min(1.0, params.torsionSpeedRatio) + 16.0);
         designDispersion();
         beta_ = -1.0;
         setBeta(0.0899);
@@ -62,6 +67,25 @@ public:
         u1In_ = u2In_ = u1tIn_ = u2tIn_ = T(0);
         bridgeForce_ = T(0);
         farEndForce_ = T(0);
+    }
+
+    /// [audio thread] Stops the string (a finger) so it sounds at f (Hz): the vibrating length
+    /// becomes c / 2f, the bow stays at the same fraction beta of it. Tension, mass and
+    /// inharmonicity are kept (B really grows as 1/L^2; the dispersion fit is not redone here).
+    /// Clamped to the lowest fundamental prepare() made room for.
+    void setFundamental(double f) noexcept
+    {
+        if (!std::isfinite(f) || f <= 0.0) return;
+        f = std::clamp(f, lowestFundamental_, 0.45 * fs_);
+        if (f == f0_) return;
+        f0_ = f;
+        params_.length = params_.waveSpeed() / (2.0 * f);
+        w0_ = 2.0 * std::numbers::pi * f0_ / fs_;
+        fLossProbe_ = std::min(5.0 * f0_, 0.4 * fs_);
+        wLossProbe_ = 2.0 * std::numbers::pi * fLossProbe_ / fs_;
+        const double beta = beta_;
+        beta_ = -1.0;
+        setBeta(beta);
     }
 
     /// [audio thread] Moves the bow point. Cheap closed-form redesign; skipped when unchanged.
@@ -239,7 +263,7 @@ private:
     }
 
     double fs_ = 48000.0, f0_ = 146.83, w0_ = 0.0, fLossProbe_ = 0.0, wLossProbe_ = 0.0;
-    double z0_ = 0.5, zt_ = 1.0, beta_ = -1.0;
+    double z0_ = 0.5, zt_ = 1.0, beta_ = -1.0, lowestFundamental_ = 20.0;
     StringParams params_;
     WaveguideOptions options_;
     DelayLine<T> bridgeOut_, bridgeBack_, fingerSide_, torsionBridge_, torsionFinger_;

@@ -63,6 +63,7 @@ public:
         shift_ = tp.temperatureShift();
         scale_ = tp.footprintRatio;
         invStep_ = 1.0 / step_;
+        built_ = true;
     }
 
     /// Friction coefficient (or y) at contact rise theta above ambient, with the rosin and
@@ -98,6 +99,10 @@ public:
 
     /// [audio thread] Ambient and rosin shift without rebuilding the table.
     void setShift(double kelvin) noexcept { shift_ = kelvin; }
+    /// [audio thread] Footprint ratio r_A without rebuilding the table.
+    void setScale(double ratio) noexcept { scale_ = ratio; }
+    /// True once build() has run (a default law is flat at 1).
+    bool built() const noexcept { return built_; }
 
     /// Largest temperature rise the steady-sliding data reaches (K); the law is flat above.
     double thetaMax() const noexcept { return thetaMax_; }
@@ -110,6 +115,7 @@ private:
     }
 
     std::vector<double> table_{1.0, 1.0};
+    bool built_ = false;
     double step_ = 1.0, invStep_ = 1.0, thetaMax_ = 1.0, shift_ = 0.0, scale_ = 1.0;
 };
 
