@@ -1,0 +1,137 @@
+// The instrument engine: fixed voices of dsp/ bowed strings, the parameter layer that turns
+// MIDI 1.0 and MPE into physical units, a modal body per output channel, stereo placement.
+// JUCE-free, so the plugin, the headless renderer and fast tests share it.
+//
+// Threading: prepare() allocates (message or loader thread). Everything else is for the audio
+// thread: no allocation, no locks, no exceptions, any parameter value survives.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "rosin/dsp/Body.h"
+#include "rosin/dsp/BowedString.h"
+#include "rosin/engine/ControllerMap.h"
+#include "rosin/engine/Parameters.h"
+#include "rosin/engine/Presets.h"
+
+namespace rosin::engine {
+
+enum class StringPolicy { LowestPosition = 0, StayOnString = 1, FixedString = 2 };
+
+/// What a test or an editor may want to know about a voice.
+struct VoiceInfo {
+    bool active = false;
+    int channel = -1, note = -1, stringIndex = -1;
+    bool keyDown = false, released = false;
+    double frequency = 0.0;   ///< stopped-string fundamental (Hz) after bend, glide, vibrato, intonation
+    double correctionCents = 0.0; ///< how far the finger moved to correct the pitch by ear
+    double force = 0.0, speed = 0.0, beta = 0.0; ///< what the string got last sample
+    double temperature = 0.0; ///< contact temperature rise (K)
+};
+
+class Synth {
+public:
+    static constexpr int maxVoices = 16;
+    static constexpr int controlInterval = 32; ///< samples between pitch/beta updates (per voice clock)
+    static constexpr int chunk = 256;          ///< internal mixing buffer length
+
+    /// [setup thread] Allocates every voice for this instrument and rate.
+    void prepare(double sampleRate, const InstrumentPreset& instrument, const ParamValues& params,
+                 ControllerMap* map = nullptr);
+    void reset() noexcept;
+
+    /// [audio thread] Sanitised: NaN becomes the default, values are clamped to the range.
+    void setParameter(int index, float value) noexcept;
+    float parameter(int index) const noexcept { return params_[static_cast<std::size_t>(index)]; }
+    const ParamValues& parameters() const noexcept { return params_; }
+
+    /// [audio thread] One MIDI 1.0 message (running status is not expected: hosts expand it).
+    void handleMidi(const std::uint8_t* data, int size) noexcept;
+    /// [audio thread] Writes numSamples to both outputs (any length: mixed in chunks).
+    void render(float* left, float* right, int numSamples) noexcept;
+
+    void releaseAll() noexcept; ///< bow lift on every voice (all notes off)
+    void killAll() noexcept;    ///< silence now (all sound off)
+
+    int activeVoiceCount() const noexcept;
+    VoiceInfo voiceInfo(int index) const noexcept;
+    double sampleRate() const noexcept { return fs_; }
+    const InstrumentPreset& instrument() const noexcept { return instrument_; }
+    bool mpeMemberChannel(int channel) const noexcept;
+
+    /// The string a note of `frequency` goes to: policy, a preferred string (stay-on-string, or
+    /// -1), and a mask of strings already sounding (a free string is preferred, as in a chord).
+    int chooseString(double frequency, int preferred, unsigned occupiedMask) const noexcept;
+    double noteFrequency(double midiNote) const noexcept;
+
+private:
+    struct ChannelState {
+        float bend = 0.0f;            ///< -1..1
+        float bendRange = -1.0f;      ///< semitones from RPN 0, < 0 while unset
+        float pressure = -1.0f;       ///< force source 0..1 (channel pressure, CC2), < 0 unseen
+        float expression = -1.0f;     ///< speed source 0..1 (CC11)
+        float position = -1.0f;       ///< bow-position source 0..1 (CC4, CC74)
+        float vibrato = 0.0f;         ///< CC1
+        float volume = 1.0f;          ///< CC7
+        bool sustain = false;
+        std::array<std::uint8_t, 32> msb{}, lsb{};
+        std::array<bool, 32> lsbSeen{};
+        int rpnMsb = 127, rpnLsb = 127;
+    };
+
+    struct Voice {
+        std::array<dsp::BowedString<float>, maxStrings> strings;
+        bool active = false, keyDown = false, sustained = false, released = false;
+        int channel = 0, note = 0, stringIndex = 0;
+        float velocity = 0.0f, polyPressure = -1.0f;
+        std::uint64_t order = 0;
+        std::array<int, 8> held{}; ///< legato note stack on this voice (top = sounding)
+        int heldCount = 0;
+        double pitch = 0.0, glideTarget = 0.0, glideStep = 0.0; ///< MIDI note numbers
+        double speed = 0.0, force = 0.0, boost = 0.0, lift = 1.0, fade = 1.0;
+        double targetForce = 0.0, targetSpeed = 0.0, beta = 0.1, frequency = 0.0;
+        double vibratoPhase = 0.0, accel = 1.0, peak = 0.0, quietSamples = 0.0;
+        float gainL = 0.7f, gainR = 0.7f, volume = 1.0f;
+        int untilControl = 0;
+        float lastTemperature = 0.0f;
+        // Intonation by ear: the Helmholtz period is the time between slip onsets at the bow.
+        bool wasStick = true;
+        int samplesSinceSlip = 0, periodsHeard = 0;
+        double heardPeriod = 0.0, targetPeriod = 0.0, correctionCents = 0.0;
+    };
+
+    void noteOn(int channel, int note, int velocity) noexcept;
+    void noteOff(int channel, int note) noexcept;
+    void controller(int channel, int cc, float value) noexcept;
+    void controlChange(int channel, int cc, int value) noexcept;
+    void dataEntry(int channel, float semitones, bool coarse, int value) noexcept;
+    void sustainOff(int channel) noexcept;
+    void releaseVoice(Voice& v) noexcept;
+    void startVoice(Voice& v, int channel, int note, int velocity, int stringIndex) noexcept;
+    void updateControl(Voice& v) noexcept;
+    void renderVoice(Voice& v, float* busL, float* busR, int n) noexcept;
+    void listen(Voice& v, bool stick) noexcept;
+    void applyFriction() noexcept;
+    Voice* findVoiceToStart() noexcept;
+    int masterOf(int channel) const noexcept; ///< MPE master of a member channel, else -1
+    float bendRangeOf(int channel) const noexcept;
+    void panFor(int stringIndex, float& l, float& r) const noexcept;
+
+    double fs_ = 48000.0;
+    InstrumentPreset instrument_;
+    ParamValues params_ = defaultParams();
+    ControllerMap* map_ = nullptr;
+    std::array<Voice, maxVoices> voices_;
+    std::array<ChannelState, 16> channels_{};
+    std::array<int, 16> lastString_{};
+    int mcmLower_ = -1, mcmUpper_ = -1; ///< member counts from MPE configuration messages
+    std::uint64_t noteCounter_ = 0;
+    std::array<dsp::ModalBody<float>, 2> body_;
+    std::vector<float> busL_, busR_;
+    double gain_ = 1.0, gainTarget_ = 1.0, bodyMix_ = 1.0, smoothing_ = 0.0, betaSmoothing_ = 0.0;
+    double ringCoefficient_ = 0.999;
+    dsp::FrictionModel appliedModel_ = dsp::FrictionModel::Thermal;
+};
+
+} // namespace rosin::engine

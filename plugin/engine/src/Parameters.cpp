@@ -1,0 +1,66 @@
+#include "rosin/engine/Parameters.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rosin::engine {
+namespace {
+// Ranges: force and speed cover playing on every instrument from violin to bass (Schelleng
+// diagrams in Euphonics ch. 9 span about 0.01-5 N and 0.01-1 m/s); beta 0.02-0.3 spans sul
+// ponticello to sul tasto. Temperatures cover rooms and rosins (violin Tg 49 C, bass 16 C).
+constexpr std::array<ParamInfo, paramCount> table{{
+    {"bow_force", "Bow force", "N", 0.0f, 5.0f, 0.6f, 0.8f, 0, ""},
+    {"bow_speed", "Bow speed", "m/s", 0.0f, 1.0f, 0.15f, 0.2f, 0, ""},
+    {"bow_position", "Bow position (beta)", "", 0.02f, 0.3f, 0.1f, 0.1f, 0, ""},
+    {"friction_model", "Friction model", "", 0.0f, 2.0f, 1.0f, 1.0f, 3, "Friction curve|Thermal|Enhanced thermal"},
+    {"contact_law", "Contact law", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Amontons|Hertz"},
+    {"rosin_tg", "Rosin glass transition", "C", 0.0f, 80.0f, 49.0f, 40.0f, 0, ""},
+    {"ambient", "Ambient temperature", "C", 0.0f, 40.0f, 20.0f, 20.0f, 0, ""},
+    {"footprint_ratio", "Footprint ratio r_A", "", 0.25f, 2.0f, 1.0f, 1.0f, 0, ""},
+    {"attack_accel", "Attack acceleration", "m/s^2", 0.1f, 30.0f, 6.0f, 4.0f, 0, ""},
+    {"attack_force", "Attack force boost", "", 0.0f, 2.0f, 0.5f, 0.5f, 0, ""},
+    {"release_time", "Bow lift time", "s", 0.005f, 2.0f, 0.08f, 0.2f, 0, ""},
+    {"portamento", "Portamento", "s", 0.0f, 1.0f, 0.06f, 0.1f, 0, ""},
+    {"legato", "Legato", "", 0.0f, 1.0f, 1.0f, 0.5f, 2, "Off|On"},
+    {"string_policy", "String choice", "", 0.0f, 2.0f, 0.0f, 1.0f, 3, "Lowest position|Stay on string|Fixed string"},
+    {"fixed_string", "Fixed string", "", 1.0f, 4.0f, 1.0f, 2.5f, 4, "1|2|3|4"},
+    {"bend_range", "Pitch-bend range", "st", 0.0f, 48.0f, 2.0f, 12.0f, 0, ""},
+    {"vibrato_rate", "Vibrato rate", "Hz", 0.5f, 10.0f, 5.5f, 5.0f, 0, ""},
+    {"vibrato_depth", "Vibrato depth", "cents", 0.0f, 100.0f, 25.0f, 25.0f, 0, ""},
+    {"body_mix", "Body", "", 0.0f, 1.0f, 1.0f, 0.5f, 0, ""},
+    {"width", "Stereo width", "", 0.0f, 1.0f, 0.6f, 0.5f, 0, ""},
+    {"gain", "Output gain", "dB", -60.0f, 12.0f, 0.0f, -12.0f, 0, ""},
+    {"mpe", "MPE", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Off|On"},
+    {"intonation", "Intonation by ear", "", 0.0f, 1.0f, 1.0f, 0.5f, 0, ""},
+}};
+} // namespace
+
+const ParamInfo& paramInfo(Param p) noexcept
+{
+    return table[static_cast<std::size_t>(std::clamp(static_cast<int>(p), 0, paramCount - 1))];
+}
+
+int paramIndex(std::string_view id) noexcept
+{
+    for (int i = 0; i < paramCount; ++i)
+        if (table[static_cast<std::size_t>(i)].id == id) return i;
+    return -1;
+}
+
+float sanitise(Param p, float value) noexcept
+{
+    const ParamInfo& info = paramInfo(p);
+    if (!std::isfinite(value)) return info.def;
+    value = std::clamp(value, info.min, info.max);
+    if (info.steps > 0) value = std::round(value);
+    return value;
+}
+
+ParamValues defaultParams() noexcept
+{
+    ParamValues v{};
+    for (int i = 0; i < paramCount; ++i) v[static_cast<std::size_t>(i)] = table[static_cast<std::size_t>(i)].def;
+    return v;
+}
+
+} // namespace rosin::engine

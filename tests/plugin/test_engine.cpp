@@ -1,0 +1,328 @@
+// The instrument engine without JUCE: presets, string choice, MIDI 1.0 and MPE in physical
+// units, pitch, release, determinism, and survival of absurd input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+
+#include "AudioChecks.h"
+#include "rosin/engine/Synth.h"
+
+using namespace rosin;
+using namespace rosin::engine;
+namespace fs = std::filesystem;
+
+namespace {
+const fs::path presetDir = ROSIN_SOURCE_DIR "/presets";
+
+struct Event {
+    int frame;
+    std::vector<std::uint8_t> bytes;
+};
+
+std::unique_ptr<Synth> makeSynth(const std::string& instrument = "cello", double fs = 48000.0,
+                                 ParamValues params = defaultParams(), ControllerMap* map = nullptr)
+{
+    auto s = std::make_unique<Synth>();
+    s->prepare(fs, loadInstrument(presetDir, instrument), params, map);
+    return s;
+}
+
+/// Render `samples` frames with events at their frames, in blocks of `block`.
+std::pair<std::vector<float>, std::vector<float>> render(Synth& s, int samples, const std::vector<Event>& events,
+                                                         int block = 512)
+{
+    std::vector<float> l(static_cast<std::size_t>(samples)), r(static_cast<std::size_t>(samples));
+    std::size_t next = 0;
+    for (int start = 0; start < samples; start += block) {
+        const int end = std::min(samples, start + block);
+        int pos = start;
+        while (next < events.size() && events[next].frame < end) {
+            const int at = std::max(pos, events[next].frame);
+            s.render(l.data() + pos, r.data() + pos, at - pos);
+            pos = at;
+            s.handleMidi(events[next].bytes.data(), static_cast<int>(events[next].bytes.size()));
+            ++next;
+        }
+        s.render(l.data() + pos, r.data() + pos, end - pos);
+    }
+    return {l, r};
+}
+
+std::vector<float> mono(const std::pair<std::vector<float>, std::vector<float>>& lr)
+{
+    std::vector<float> m(lr.first.size());
+    for (std::size_t i = 0; i < m.size(); ++i) m[i] = lr.first[i] + lr.second[i];
+    return m;
+}
+
+Event on(int frame, int note, int vel = 100, int ch = 0) { return {frame, {std::uint8_t(0x90 | ch), std::uint8_t(note), std::uint8_t(vel)}}; }
+Event off(int frame, int note, int ch = 0) { return {frame, {std::uint8_t(0x80 | ch), std::uint8_t(note), 0}}; }
+Event cc(int frame, int number, int value, int ch = 0) { return {frame, {std::uint8_t(0xB0 | ch), std::uint8_t(number), std::uint8_t(value)}}; }
+Event bend(int frame, int value14, int ch = 0) { return {frame, {std::uint8_t(0xE0 | ch), std::uint8_t(value14 & 0x7F), std::uint8_t(value14 >> 7)}}; }
+Event pressure(int frame, int value, int ch) { return {frame, {std::uint8_t(0xD0 | ch), std::uint8_t(value)}}; }
+} // namespace
+
+TEST(EnginePresets, EveryInstrumentLoadsWithItsFourStringsInPitchOrder)
+{
+    for (const std::string name : {"violin", "viola", "cello", "double-bass"}) {
+        const InstrumentPreset p = loadInstrument(presetDir, name);
+        ASSERT_EQ(p.stringCount, 4) << name;
+        for (int s = 1; s < 4; ++s) EXPECT_GT(p.strings[s].fundamental(), p.strings[s - 1].fundamental()) << name;
+        EXPECT_GE(p.body.count, 8) << name;
+        EXPECT_TRUE(p.strings[0].validate().empty()) << name;
+    }
+    EXPECT_NEAR(loadInstrument(presetDir, "double-bass").rosinTg, 16.0, 1e-9);
+    EXPECT_EQ(listPresets(presetDir, "instruments").size(), 4u);
+    EXPECT_EQ(loadExciter(presetDir, "enhanced-rod").contact, dsp::ContactLaw::PowerLaw);
+    const MappingPreset keyboard = loadMapping(presetDir, "keyboard");
+    ASSERT_EQ(keyboard.entries.size(), 4u);
+    EXPECT_EQ(keyboard.entries[0].param, static_cast<int>(Param::BowForce));
+}
+
+TEST(EnginePresets, BadFilesNameTheFileAndTheField)
+{
+    const fs::path dir = fs::temp_directory_path() / "rosin-engine-presets";
+    fs::create_directories(dir);
+    auto expectError = [&](const std::string& text, const std::string& fieldWords, const std::string& kind) {
+        const fs::path f = dir / "bad.json";
+        std::ofstream(f) << text;
+        try {
+            if (kind == "instrument") loadInstrument(presetDir, f.string());
+            else if (kind == "mapping") loadMapping(presetDir, f.string());
+            else loadExciter(presetDir, f.string());
+            ADD_FAILURE() << "no error for " << text;
+        } catch (const std::runtime_error& e) {
+            const std::string msg = e.what();
+            EXPECT_NE(msg.find(f.string()), std::string::npos) << msg;
+            EXPECT_NE(msg.find(fieldWords), std::string::npos) << msg;
+        }
+    };
+    expectError("{", "not valid JSON", "instrument");
+    expectError(R"({"format":"rosin-instrument/1","name":"x","strings":"strings/cello.json","body":{"modes":[{"f_hz":100,"q":-3,"gain":1}]}})",
+                "body.modes[0]: field 'q'", "instrument");
+    expectError(R"({"format":"rosin-instrument/1","name":"x","strings":"strings/none.json","body":{"modes":[]}})",
+                "field 'strings'", "instrument");
+    expectError(R"({"format":"rosin-mapping/1","name":"m","mappings":[{"cc":7,"param":"bow_forse"}]})",
+                "mappings[0]: field 'param'", "mapping");
+    expectError(R"({"format":"rosin-exciter/1","name":"e","friction_model":"magic"})", "field 'friction_model'", "exciter");
+    EXPECT_THROW(loadInstrument(presetDir, "theremin"), std::runtime_error);
+}
+
+TEST(EngineStrings, NotesGoWhereACellistWouldPlayThem)
+{
+    auto s = makeSynth("cello");
+    // Lowest position: the highest open string at or below the note.
+    EXPECT_EQ(s->chooseString(s->noteFrequency(36), -1, 0), 0); // C2, open C
+    EXPECT_EQ(s->chooseString(s->noteFrequency(47), -1, 0), 1); // B2 on G
+    EXPECT_EQ(s->chooseString(s->noteFrequency(50), -1, 0), 2); // D3, open D
+    EXPECT_EQ(s->chooseString(s->noteFrequency(64), -1, 0), 3); // E4 on A
+    EXPECT_EQ(s->chooseString(s->noteFrequency(24), -1, 0), 0); // below the cello: C string tuned down
+    // A chord: with D taken, F3 goes to the G string (a free string that reaches it).
+    EXPECT_EQ(s->chooseString(s->noteFrequency(53), -1, 1u << 2), 1);
+    s->setParameter(static_cast<int>(Param::StringPolicy), 1.0f); // stay on string
+    EXPECT_EQ(s->chooseString(s->noteFrequency(57), 1, 0), 1);    // A3 stays on G (14 semitones up)
+    EXPECT_EQ(s->chooseString(s->noteFrequency(80), 1, 0), 3);    // G#5 is beyond G's reach
+    s->setParameter(static_cast<int>(Param::StringPolicy), 2.0f); // fixed string 2 (G)
+    s->setParameter(static_cast<int>(Param::FixedString), 2.0f);
+    EXPECT_EQ(s->chooseString(s->noteFrequency(55), -1, 0), 1);
+}
+
+TEST(EnginePitch, NotesSoundWithinFiveCentsAfterTheAttack)
+{
+    for (const auto& [instrument, note] : std::vector<std::pair<std::string, int>>{
+             {"cello", 50}, {"cello", 53}, {"cello", 45}, {"violin", 67}, {"violin", 76}, {"viola", 62}, {"double-bass", 38}}) {
+        auto s = makeSynth(instrument);
+        const int fs = 48000;
+        const auto out = mono(render(*s, fs, {on(0, note)}));
+        const double f = test::pitchHz(out, fs, fs / 2, fs, 25.0, 2000.0);
+        EXPECT_LT(std::abs(test::cents(f, test::midiToHz(note))), 5.0) << instrument << " note " << note << ": " << f << " Hz";
+        EXPECT_GT(test::rms(out, fs / 2, fs), 1e-3) << instrument;
+    }
+}
+
+// The physics the intonation corrects: with the finger fixed, a bowed string plays flatter as
+// the bow force rises (McIntyre & Woodhouse; Euphonics ch. 9), more so with the thermal model.
+TEST(EnginePitch, WithoutIntonationTheStringFlattensAsTheForceRises)
+{
+    double previous = 1e9;
+    for (float force : {0.1f, 0.3f, 0.6f}) {
+        ParamValues p = defaultParams();
+        p[static_cast<int>(Param::Intonation)] = 0.0f;
+        p[static_cast<int>(Param::BowForce)] = force;
+        auto s = makeSynth("violin", 48000.0, p);
+        const auto out = mono(render(*s, 48000, {on(0, 67)}));
+        const double c = test::cents(test::pitchHz(out, 48000, 24000, 48000), test::midiToHz(67));
+        EXPECT_LT(c, previous - 1.0) << force;
+        EXPECT_LT(c, 1.0) << force;
+        previous = c;
+    }
+    EXPECT_LT(previous, -8.0);
+}
+
+TEST(EngineRelease, SilenceAfterTheBowLiftsAndTheStringIsDamped)
+{
+    auto s = makeSynth("cello");
+    const int fs = 48000;
+    const auto out = mono(render(*s, 3 * fs, {on(0, 50), off(fs / 2, 50)}));
+    EXPECT_GT(test::rms(out, fs / 4, fs / 2), 1e-2);
+    EXPECT_EQ(s->activeVoiceCount(), 0);
+    EXPECT_LT(test::peakAbs(out, 2 * fs, 3 * fs), 1e-6); // -120 dB: only the body's last decay
+}
+
+TEST(EngineDeterminism, BlockSizeDoesNotChangeOneBit)
+{
+    const std::vector<Event> events{on(0, 50, 90), cc(3000, 74, 90), bend(4100, 9000), on(7001, 57, 60),
+                                    pressure(9000, 100, 0), off(20000, 50), off(26000, 57)};
+    auto reference = makeSynth("cello");
+    const auto ref = render(*reference, 30000, events, 30000);
+    for (int block : {1, 7, 64, 512, 4096}) {
+        auto s = makeSynth("cello");
+        const auto got = render(*s, 30000, events, block);
+        ASSERT_EQ(got.first, ref.first) << "block " << block;
+        ASSERT_EQ(got.second, ref.second) << "block " << block;
+    }
+}
+
+TEST(EngineMidi, FourteenBitControllersReachTheBowForce)
+{
+    auto s = makeSynth("cello");
+    const int fs = 48000;
+    // CC2 MSB 32, LSB 64: (32*128 + 64)/16383 = 0.2539 -> force = 2 * 0.2539 * nominal.
+    render(*s, fs / 2, {on(0, 50), cc(10, 2, 32), cc(11, 34, 64)});
+    const double nominal = s->parameter(static_cast<int>(Param::BowForce));
+    EXPECT_NEAR(s->voiceInfo(0).force, 2.0 * (32 * 128 + 64) / 16383.0 * nominal, 1e-3 * nominal);
+    // A new MSB alone clears the LSB: 7-bit senders work too.
+    render(*s, fs / 2, {cc(0, 2, 96)});
+    EXPECT_NEAR(s->voiceInfo(0).force, 2.0 * 96 / 127.0 * nominal, 1e-3 * nominal);
+}
+
+TEST(EngineMidi, RpnBendRangeAndSustain)
+{
+    auto s = makeSynth("cello");
+    const int fs = 48000;
+    // RPN 0 = 12 semitones, then full bend up: D3 sounds as D4.
+    render(*s, fs / 2, {cc(0, 101, 0), cc(1, 100, 0), cc(2, 6, 12), cc(3, 101, 127), cc(4, 100, 127),
+                        on(10, 50), bend(20, 16383)});
+    EXPECT_NEAR(test::cents(s->voiceInfo(0).frequency, test::midiToHz(62)), s->voiceInfo(0).correctionCents, 1.0);
+    // Sustain holds the note past its note-off; releasing the pedal lifts the bow.
+    render(*s, fs / 4, {cc(0, 64, 127), off(10, 50)});
+    EXPECT_TRUE(s->voiceInfo(0).active);
+    EXPECT_FALSE(s->voiceInfo(0).released);
+    render(*s, 10, {cc(0, 64, 0)});
+    EXPECT_TRUE(s->voiceInfo(0).released);
+}
+
+TEST(EngineMidi, LegatoGlidesOnOneStringAndReturnsToTheHeldNote)
+{
+    ParamValues p = defaultParams();
+    p[static_cast<int>(Param::Legato)] = 1.0f;
+    p[static_cast<int>(Param::Portamento)] = 0.05f;
+    auto s = makeSynth("cello", 48000.0, p);
+    render(*s, 24000, {on(0, 50), on(12000, 52)});
+    EXPECT_EQ(s->activeVoiceCount(), 1);
+    EXPECT_NEAR(test::cents(s->voiceInfo(0).frequency, test::midiToHz(52)), s->voiceInfo(0).correctionCents, 0.5);
+    render(*s, 12000, {off(0, 52)});
+    EXPECT_EQ(s->activeVoiceCount(), 1);
+    EXPECT_NEAR(test::cents(s->voiceInfo(0).frequency, test::midiToHz(50)), s->voiceInfo(0).correctionCents, 0.5);
+    EXPECT_FALSE(s->voiceInfo(0).released);
+}
+
+TEST(EngineMidi, MidiLearnAssignsTheNextControllerOverTheFullRange)
+{
+    ControllerMap map;
+    auto s = makeSynth("cello", 48000.0, defaultParams(), &map);
+    map.armLearn(static_cast<int>(Param::Ambient));
+    render(*s, 100, {cc(0, 21, 127)});
+    EXPECT_EQ(map.learning(), -1);
+    EXPECT_EQ(map.get(21).param, static_cast<int>(Param::Ambient));
+    EXPECT_FLOAT_EQ(s->parameter(static_cast<int>(Param::Ambient)), 40.0f);
+    render(*s, 100, {cc(0, 21, 0)});
+    EXPECT_FLOAT_EQ(s->parameter(static_cast<int>(Param::Ambient)), 0.0f);
+    // Unlearned controllers keep their built-in meaning and do not touch parameters.
+    render(*s, 100, {cc(0, 22, 64)});
+    EXPECT_FLOAT_EQ(s->parameter(static_cast<int>(Param::Ambient)), 0.0f);
+}
+
+TEST(EngineMpe, PerNoteControlAffectsOnlyItsNote)
+{
+    ParamValues p = defaultParams();
+    p[static_cast<int>(Param::Mpe)] = 1.0f;
+    const int n = 36000;
+    // Two notes on member channels 2 and 3 (indices 1, 2); pressure, CC74 and bend on channel 2 only.
+    const std::vector<Event> expression{pressure(6000, 120, 1), cc(9000, 74, 20, 1), bend(12000, 12000, 1)};
+    std::vector<Event> both{on(0, 50, 100, 1), on(0, 57, 100, 2)};
+    both.insert(both.end(), expression.begin(), expression.end());
+    std::vector<Event> firstOnly{on(0, 50, 100, 1)};
+    firstOnly.insert(firstOnly.end(), expression.begin(), expression.end());
+    auto a = makeSynth("cello", 48000.0, p), b = makeSynth("cello", 48000.0, p), c = makeSynth("cello", 48000.0, p);
+    const auto mixed = render(*a, n, both), alone = render(*b, n, firstOnly), second = render(*c, n, {on(0, 57, 100, 2)});
+    // The mix is linear after the strings: (both) - (first alone) must be the second note untouched.
+    double worst = 0.0, level = test::peakAbs(second.first, 0, n);
+    for (int i = 0; i < n; ++i) worst = std::max(worst, std::abs(static_cast<double>(mixed.first[i] - alone.first[i] - second.first[i])));
+    EXPECT_GT(level, 1e-2);
+    EXPECT_LT(worst, 1e-5 * std::max(1.0, level));
+    // And the expression did reach the first note: its bend is 12000 -> (12000-8192)/8191 * 48 st.
+    EXPECT_NEAR(test::cents(a->voiceInfo(0).frequency, test::midiToHz(50 + (12000 - 8192) / 8191.0 * 48)), a->voiceInfo(0).correctionCents, 1.0);
+}
+
+TEST(EngineMpe, ConfigurationMessageSetsTheZones)
+{
+    auto s = makeSynth("cello");
+    EXPECT_FALSE(s->mpeMemberChannel(3));
+    std::vector<Event> mcm{cc(0, 101, 0), cc(0, 100, 6), cc(0, 6, 7)}; // lower zone, 7 members
+    render(*s, 10, mcm);
+    EXPECT_TRUE(s->mpeMemberChannel(1));
+    EXPECT_TRUE(s->mpeMemberChannel(7));
+    EXPECT_FALSE(s->mpeMemberChannel(8));
+    render(*s, 10, {cc(0, 101, 0, 15), cc(0, 100, 6, 15), cc(0, 6, 4, 15)}); // upper zone, 4 members
+    EXPECT_TRUE(s->mpeMemberChannel(11));
+    EXPECT_FALSE(s->mpeMemberChannel(10));
+}
+
+TEST(EngineRobustness, AbsurdParametersAndControllersNeverGiveNanOrBlowUp)
+{
+    auto s = makeSynth("violin");
+    std::vector<Event> events{on(0, 67), on(0, 88), on(0, 55)};
+    const auto first = render(*s, 4800, events);
+    const std::vector<float> absurd{std::nanf(""), INFINITY, -INFINITY, 1e30f, -1e30f, 0.0f};
+    int frame = 0;
+    for (float x : absurd) {
+        for (int i = 0; i < paramCount; ++i) s->setParameter(i, x);
+        const auto out = render(*s, 2400, {cc(0, 2, 127), bend(1, 16383), pressure(2, 127, 0), on(3, frame % 128)});
+        for (std::size_t k = 0; k < out.first.size(); ++k) {
+            ASSERT_TRUE(std::isfinite(out.first[k]) && std::isfinite(out.second[k])) << x;
+            ASSERT_LE(std::abs(out.first[k]), 4.0f);
+        }
+        ++frame;
+    }
+    for (int i = 0; i < paramCount; ++i) {
+        const float v = s->parameter(i);
+        EXPECT_GE(v, paramInfo(i).min);
+        EXPECT_LE(v, paramInfo(i).max);
+    }
+    // Garbage MIDI: short, empty and system messages are ignored.
+    const std::uint8_t junk[] = {0xF0, 0x7E, 0xF7};
+    s->handleMidi(junk, 3);
+    s->handleMidi(junk, 0);
+    s->handleMidi(nullptr, 3);
+    const std::uint8_t shortNote[] = {0x90};
+    s->handleMidi(shortNote, 1);
+}
+
+TEST(EngineRobustness, FrictionModelSwitchMidNoteKeepsTheNoteSounding)
+{
+    auto s = makeSynth("cello");
+    const int fs = 48000;
+    render(*s, fs / 2, {on(0, 50)});
+    for (int m : {0, 2, 1}) {
+        s->setParameter(static_cast<int>(Param::FrictionModel), static_cast<float>(m));
+        s->setParameter(static_cast<int>(Param::ContactLaw), static_cast<float>(m % 2));
+        const auto out = mono(render(*s, fs / 2, {}));
+        EXPECT_GT(test::rms(out, fs / 4, fs / 2), 1e-2) << m;
+        EXPECT_LT(std::abs(test::cents(test::pitchHz(out, fs, fs / 8, fs / 2), test::midiToHz(50))), 10.0) << m;
+    }
+}
