@@ -21,7 +21,7 @@ constexpr std::array<ParamInfo, paramCount> table{{
     {"attack_force", "Attack force boost", "", 0.0f, 2.0f, 0.5f, 0.5f, 0, ""},
     {"release_time", "Bow lift time", "s", 0.005f, 2.0f, 0.08f, 0.2f, 0, ""},
     {"portamento", "Portamento", "s", 0.0f, 1.0f, 0.06f, 0.1f, 0, ""},
-    {"legato", "Legato", "", 0.0f, 1.0f, 1.0f, 0.5f, 2, "Off|On"},
+    {"legato", "Legato", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Off|On"},
     {"string_policy", "String choice", "", 0.0f, 2.0f, 0.0f, 1.0f, 3, "Lowest position|Stay on string|Fixed string"},
     {"fixed_string", "Fixed string", "", 1.0f, 4.0f, 1.0f, 2.5f, 4, "1|2|3|4"},
     {"bend_range", "Pitch-bend range", "st", 0.0f, 48.0f, 2.0f, 12.0f, 0, ""},

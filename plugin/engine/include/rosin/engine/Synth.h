@@ -59,6 +59,9 @@ public:
     double sampleRate() const noexcept { return fs_; }
     const InstrumentPreset& instrument() const noexcept { return instrument_; }
     bool mpeMemberChannel(int channel) const noexcept;
+    /// A number the owner attaches (the plugin: which instrument this engine was built for).
+    void setTag(int tag) noexcept { tag_ = tag; }
+    int tag() const noexcept { return tag_; }
 
     /// The string a note of `frequency` goes to: policy, a preferred string (stay-on-string, or
     /// -1), and a mask of strings already sounding (a free string is preferred, as in a chord).
@@ -132,6 +135,7 @@ private:
     double gain_ = 1.0, gainTarget_ = 1.0, bodyMix_ = 1.0, smoothing_ = 0.0, betaSmoothing_ = 0.0;
     double ringCoefficient_ = 0.999;
     dsp::FrictionModel appliedModel_ = dsp::FrictionModel::Thermal;
+    int tag_ = -1;
 };
 
 } // namespace rosin::engine

@@ -1,0 +1,89 @@
+// Headless plugin host: loads the BUILT Rosin VST3 or LV2 (or any instrument plugin), plays
+// timed MIDI and parameter automation at any rate and block size, and returns the audio. The
+// API is plain C++ so tests and the CLI do not need JUCE headers; JUCE lives in PluginHost.cpp.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rosin::host {
+
+struct TimedMidi {
+    double seconds = 0.0;
+    std::vector<std::uint8_t> bytes;
+};
+
+struct Automation {
+    double seconds = 0.0;   ///< applied at the start of the block containing this time
+    std::string paramId;
+    float normalised = 0.0f; ///< the host's 0-1 value, as a DAW automation lane sends it
+};
+
+struct HostedParam {
+    std::string id, name, text;
+    float normalised = 0.0f, defaultNormalised = 0.0f;
+    int steps = 0; ///< 0 continuous, else the number of discrete values
+};
+
+struct RenderRequest {
+    double sampleRate = 48000.0;
+    int blockSize = 512;
+    double seconds = 1.0;
+    std::vector<TimedMidi> midi;
+    std::vector<Automation> automation;
+    bool audit = false; ///< count allocations and locks inside the plugin's processBlock
+};
+
+struct AuditCounts {
+    std::uint64_t blocks = 0;
+    std::uint64_t allocationsInPlugin = 0, locksInPlugin = 0;   ///< inside Rosin's processBlock
+    std::uint64_t allocationsInCall = 0, locksInCall = 0;       ///< whole host->plugin call (wrappers too)
+    bool pluginScopeSeen = false; ///< the plugin reported its scope (it is Rosin, built with the hook)
+};
+
+struct RenderResult {
+    std::vector<float> left, right;
+    AuditCounts audit;
+};
+
+class PluginHost {
+public:
+    /// Loads a .vst3 bundle or an .lv2 bundle. Throws std::runtime_error with the reason.
+    explicit PluginHost(const std::filesystem::path& plugin);
+    ~PluginHost();
+    PluginHost(const PluginHost&) = delete;
+    PluginHost& operator=(const PluginHost&) = delete;
+
+    std::string formatName() const;
+    std::string pluginName() const;
+    std::vector<HostedParam> parameters() const;
+    /// Sets a parameter by ID: "0.6" through the plugin's own text parser, "@0.25" normalised.
+    void setParameter(const std::string& id, const std::string& value);
+    float getParameter(const std::string& id) const;
+    /// One parameter by ID (throws when the plugin has none by that ID).
+    HostedParam parameter(const std::string& id) const;
+
+    std::vector<char> getState() const;
+    void setState(const std::vector<char>& state);
+    /// Back to the state the plugin had when it was loaded.
+    void restoreInitialState();
+
+    /// Prepares at the request's rate and block (a fresh engine), then renders.
+    RenderResult render(const RenderRequest& request);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// MIDI file (type 0 or 1, all tracks merged) to timed messages. Throws naming the file.
+std::vector<TimedMidi> readMidiFile(const std::filesystem::path& file);
+/// Text event list: "seconds hexbyte hexbyte ..." per line, '#' comments. Throws naming file and line.
+std::vector<TimedMidi> readEventList(const std::filesystem::path& file);
+/// Writes 32-bit float stereo WAV atomically (temp file + rename). Throws naming the file.
+void writeWav(const std::filesystem::path& file, const std::vector<float>& left, const std::vector<float>& right,
+              double sampleRate);
+
+} // namespace rosin::host

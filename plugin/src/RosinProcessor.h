@@ -1,0 +1,105 @@
+// The JUCE AudioProcessor: host parameters, MIDI, state and presets around engine::Synth.
+//
+// Threads. The audio thread owns the current Synth. A new Synth (other instrument or rate)
+// is built off the audio thread and handed over through one atomic pointer; the audio thread
+// swaps it in at the top of a block, fades the old one out over a few milliseconds and gives
+// it back through an SPSC queue, to be freed by the loader thread. Parameters are the host's
+// atomics; MIDI-learn slots are single-word atomics (engine::ControllerMap).
+#pragma once
+#include <juce_audio_processors/juce_audio_processors.h>
+#include <juce_audio_utils/juce_audio_utils.h>
+
+#include <array>
+#include <atomic>
+#include <memory>
+#include <mutex>
+
+#include "SpscQueue.h"
+#include "rosin/engine/ControllerMap.h"
+#include "rosin/engine/Synth.h"
+
+namespace rosin::plugin {
+
+class RosinProcessor : public juce::AudioProcessor {
+public:
+    static constexpr const char* instrumentParamId = "instrument";
+    static const juce::StringArray& instrumentNames();
+
+    RosinProcessor();
+    ~RosinProcessor() override;
+
+    void prepareToPlay(double sampleRate, int maximumExpectedSamplesPerBlock) override;
+    void releaseResources() override;
+    bool isBusesLayoutSupported(const BusesLayout& layouts) const override;
+    void processBlock(juce::AudioBuffer<float>&, juce::MidiBuffer&) override;
+    using AudioProcessor::processBlock;
+
+    juce::AudioProcessorEditor* createEditor() override;
+    bool hasEditor() const override { return true; }
+
+    const juce::String getName() const override { return "Rosin"; }
+    bool acceptsMidi() const override { return true; }
+    bool producesMidi() const override { return false; }
+    bool isMidiEffect() const override { return false; }
+    double getTailLengthSeconds() const override { return 2.0; }
+
+    int getNumPrograms() override { return 1; }
+    int getCurrentProgram() override { return 0; }
+    void setCurrentProgram(int) override {}
+    const juce::String getProgramName(int) override { return "Default"; }
+    void changeProgramName(int, const juce::String&) override {}
+
+    void getStateInformation(juce::MemoryBlock& destData) override;
+    void setStateInformation(const void* data, int sizeInBytes) override;
+
+    /// [any thread but audio] Load an instrument preset by name; applyDefaults also sets the
+    /// bow parameters and rosin the preset suggests. Throws std::runtime_error on a bad file.
+    void loadInstrument(const juce::String& name, bool applyDefaults);
+    void loadExciter(const juce::String& name);
+    void loadMapping(const juce::String& name);
+
+    juce::AudioProcessorValueTreeState& parameters() noexcept { return state_; }
+    engine::ControllerMap& controllerMap() noexcept { return map_; }
+    juce::String currentInstrument() const;
+    int activeVoices() const noexcept { return activeVoices_.load(std::memory_order_relaxed); }
+
+private:
+    class Loader;
+    static juce::AudioProcessorValueTreeState::ParameterLayout createLayout();
+    std::unique_ptr<engine::Synth> buildSynth(const juce::String& instrument, double sampleRate) const;
+    void handOver(std::unique_ptr<engine::Synth> synth);
+    void collectGarbage();
+    engine::ParamValues currentParams() const;
+    void renderSynth(engine::Synth& synth, juce::AudioBuffer<float>& buffer, const juce::MidiBuffer* midi,
+                     bool pushParams) noexcept;
+
+    juce::AudioProcessorValueTreeState state_;
+    engine::ControllerMap map_;
+    std::array<std::atomic<float>*, engine::paramCount> raw_{};
+    std::array<float, engine::paramCount> pushed_{};
+    std::atomic<float>* instrumentRaw_ = nullptr;
+
+    // Audio-thread owned.
+    engine::Synth* current_ = nullptr;
+    engine::Synth* retiring_ = nullptr;
+    int retiringLeft_ = 0;
+    juce::AudioBuffer<float> fadeBuffer_;
+    static constexpr int fadeSamples = 512;
+
+    // Crossing threads.
+    std::atomic<engine::Synth*> pending_{nullptr};
+    SpscQueue<engine::Synth*, 16> trash_;
+    std::atomic<double> sampleRate_{0.0};
+    std::atomic<int> loadedInstrument_{-1};   ///< index of the instrument whose Synth is installed or pending
+    int installedInstrument_ = -1;            ///< [audio thread] index of current_'s instrument
+    std::atomic<int> activeVoices_{0};
+
+    mutable std::mutex loadMutex_; ///< serialises loaders (never taken on the audio thread)
+    juce::String instrumentName_{"cello"};
+    std::unique_ptr<Loader> loader_;
+    juce::File presetDir_;
+
+    JUCE_DECLARE_NON_COPYABLE_WITH_LEAK_DETECTOR(RosinProcessor)
+};
+
+} // namespace rosin::plugin
