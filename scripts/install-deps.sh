@@ -11,6 +11,12 @@ CORE_PKGS=(
   libcairo2-dev fonts-dejavu-core          # figures (PNG) drawn by lab/
   libopenmpi-dev openmpi-bin               # Guettler sweeps over several processes/machines
   libnlopt-cxx-dev                         # fitting model extensions in diagnosis
+  # The instrument: JUCE 7.0.5 from Debian (its -dev dependencies come with it), LV2 headers,
+  # JACK for the Standalone, and the checks a DAW user's machine would run.
+  juce-modules-source lv2-dev libjack-jackd2-dev
+  lilv-utils                               # lv2ls / lv2info see the built LV2
+  ardour                                   # ardour7-lua: a real DAW loads VST3 and LV2 headless
+  xvfb xauth                               # the Standalone needs an X display
 )
 
 missing=()

@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -72,6 +74,8 @@ int main(int argc, char** argv)
     render->add_option("--block", block, "block size (samples)")->check(CLI::Range(1, 65536));
     render->add_option("--seconds", seconds, "length (default: last event + tail)")->check(CLI::Range(0.0, 3600.0));
     render->add_option("--tail", tail, "seconds after the last event")->check(CLI::Range(0.0, 60.0));
+    std::string preset;
+    render->add_option("--preset", preset, "instrument preset: violin, viola, cello or double-bass");
     render->add_option("--set", sets, "parameter before playing: ID=VALUE in its units, or ID=@0.5 normalised (repeatable)");
     render->add_option("--automation", automationFile, "CSV seconds,param_id,normalised (applied per block)");
     render->add_option("--state-in", stateIn, "plugin state to load first (from --state-out)");
@@ -79,12 +83,44 @@ int main(int argc, char** argv)
     render->add_flag("--audit", audit, "count heap allocations and mutex locks inside processBlock");
     render->add_option("--report", report, "JSON report (format, blocks, audit counts, peak)");
 
+    auto* bench = app.add_subcommand("bench", "time one held note through the plugin (the shared/bench/peers protocol): "
+                                              "prints RESULT <name> <ns_per_sample> <rt_factor> <rms>");
+    double benchSeconds = 10.0, benchSr = 48000.0, warmup = 0.5, freq = 440.0;
+    int benchBlock = 256, reps = 5, voices = 1;
+    std::string benchName = "rosin_plugin", benchPreset = "violin";
+    bench->add_option("--plugin", plugin, "the built plugin bundle (.vst3 or .lv2)")->required();
+    bench->add_option("--seconds", benchSeconds, "audio seconds per timed pass")->check(CLI::Range(0.01, 3600.0));
+    bench->add_option("--sr", benchSr, "sample rate")->check(CLI::Range(8000.0, 768000.0));
+    bench->add_option("--block", benchBlock, "block size")->check(CLI::Range(1, 65536));
+    bench->add_option("--reps", reps, "timed passes (best is reported)")->check(CLI::Range(1, 1000));
+    bench->add_option("--warmup", warmup, "untimed seconds first")->check(CLI::Range(0.0, 60.0));
+    bench->add_option("--name", benchName, "name in the RESULT line")->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    bench->add_option("--freq", freq, "pitch of the held note (Hz), rounded to a MIDI note")->check(CLI::Range(20.0, 5000.0));
+    bench->add_option("--voices", voices, "notes held at once (a chord spread over the range)")->check(CLI::Range(1, 16));
+    bench->add_option("--preset", benchPreset, "instrument preset");
+
     auto* params = app.add_subcommand("params", "list the plugin's parameters (ID, name, value)");
     params->add_option("--plugin", plugin, "the built plugin bundle (.vst3 or .lv2)")->required();
 
     CLI11_PARSE(app, argc, argv);
     try {
         PluginHost host(plugin);
+        if (bench->parsed()) {
+            host.setParameter("instrument", benchPreset);
+            std::vector<TimedMidi> notes;
+            const int root = static_cast<int>(std::lround(69.0 + 12.0 * std::log2(freq / 440.0)));
+            for (int v = 0; v < voices; ++v) notes.push_back({0.0, {0x90, static_cast<std::uint8_t>(std::clamp(root - 5 * v, 0, 127)), 100}});
+            const BenchResult b = host.bench(benchSr, benchBlock, benchSeconds, reps, warmup, notes);
+            const double ns = 1e9 * b.bestPassSeconds / static_cast<double>(b.samplesPerPass);
+            const double rt = static_cast<double>(b.samplesPerPass) / benchSr / b.bestPassSeconds;
+            std::printf("%s through %s, %d voice(s) of %s at %.0f Hz, block %d: best %.3f s, median %.3f s per %.1f s pass; "
+                        "%.1f ns per sample per voice; %.0f voices would fit in real time on this core\n",
+                        host.pluginName().c_str(), host.formatName().c_str(), voices, benchPreset.c_str(), benchSr, benchBlock,
+                        b.bestPassSeconds, b.medianPassSeconds, static_cast<double>(b.samplesPerPass) / benchSr, ns / voices,
+                        1e9 / benchSr / (ns / voices));
+            std::printf("RESULT %s %.3f %.1f %.6g\n", benchName.c_str(), ns, rt, b.rms);
+            return b.rms > 1e-6 ? 0 : 1;
+        }
         if (params->parsed()) {
             for (const auto& p : host.parameters())
                 std::printf("%-18s %-28s %s\n", p.id.c_str(), p.name.c_str(), p.text.c_str());
@@ -99,6 +135,12 @@ int main(int argc, char** argv)
         if (!eventsFile.empty()) req.midi = readEventList(eventsFile);
         if (!automationFile.empty()) req.automation = readAutomation(automationFile);
         if (!stateIn.empty()) host.setState(readBytes(stateIn));
+        if (!preset.empty()) {
+            host.setParameter("instrument", preset);
+            if (host.parameter("instrument").text != preset)
+                throw std::runtime_error("--preset " + preset + ": the plugin has no such instrument (it shows '" +
+                                         host.parameter("instrument").text + "')");
+        }
         for (const auto& s : sets) {
             const auto eq = s.find('=');
             if (eq == std::string::npos) throw std::runtime_error("--set " + s + ": expected ID=VALUE");

@@ -4,6 +4,7 @@
 #include <juce_audio_processors/juce_audio_processors.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -205,6 +206,52 @@ RenderResult PluginHost::render(const RenderRequest& req)
     result.audit.pluginScopeSeen = c.scopeSeen;
     plugin.releaseResources();
     return result;
+}
+
+BenchResult PluginHost::bench(double sampleRate, int blockSize, double seconds, int reps, double warmup,
+                              const std::vector<TimedMidi>& midiIn)
+{
+    auto& plugin = *impl_->plugin;
+    plugin.setNonRealtime(false);
+    plugin.setPlayConfigDetails(0, 2, sampleRate, blockSize);
+    plugin.prepareToPlay(sampleRate, blockSize);
+    juce::AudioBuffer<float> buffer(2, blockSize);
+    juce::MidiBuffer midi, empty;
+    for (const auto& m : midiIn) midi.addEvent(m.bytes.data(), static_cast<int>(m.bytes.size()), 0);
+    buffer.clear();
+    plugin.processBlock(buffer, midi);
+    const auto warm = static_cast<long long>(warmup * sampleRate);
+    for (long long done = blockSize; done < warm; done += blockSize) {
+        buffer.clear();
+        plugin.processBlock(buffer, empty);
+    }
+    BenchResult r;
+    r.samplesPerPass = static_cast<long long>(seconds * sampleRate) / blockSize * blockSize;
+    std::vector<double> passes;
+    double sumsq = 0.0;
+    long long count = 0;
+    for (int rep = 0; rep < reps; ++rep) {
+        double passSumsq = 0.0;
+        const auto t0 = std::chrono::steady_clock::now();
+        for (long long done = 0; done < r.samplesPerPass; done += blockSize) {
+            buffer.clear();
+            plugin.processBlock(buffer, empty);
+            const float* l = buffer.getReadPointer(0);
+            for (int i = 0; i < blockSize; ++i) {
+                passSumsq += static_cast<double>(l[i]) * l[i];
+                r.peak = std::max(r.peak, static_cast<double>(std::abs(l[i])));
+            }
+        }
+        passes.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        sumsq += passSumsq;
+        count += r.samplesPerPass;
+    }
+    std::sort(passes.begin(), passes.end());
+    r.bestPassSeconds = passes.front();
+    r.medianPassSeconds = passes[passes.size() / 2];
+    r.rms = std::sqrt(sumsq / static_cast<double>(std::max(1LL, count)));
+    plugin.releaseResources();
+    return r;
 }
 
 std::vector<TimedMidi> readMidiFile(const fs::path& file)

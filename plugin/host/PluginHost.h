@@ -48,6 +48,12 @@ struct RenderResult {
     AuditCounts audit;
 };
 
+struct BenchResult {
+    double bestPassSeconds = 0.0, medianPassSeconds = 0.0;
+    long long samplesPerPass = 0;
+    double rms = 0.0, peak = 0.0;
+};
+
 class PluginHost {
 public:
     /// Loads a .vst3 bundle or an .lv2 bundle. Throws std::runtime_error with the reason.
@@ -72,6 +78,11 @@ public:
 
     /// Prepares at the request's rate and block (a fresh engine), then renders.
     RenderResult render(const RenderRequest& request);
+
+    /// Times processBlock as a DAW would call it (real-time mode): `midi` is sent in the first
+    /// block, `warmup` seconds run untimed, then `reps` passes of `seconds` each are timed.
+    BenchResult bench(double sampleRate, int blockSize, double seconds, int reps, double warmup,
+                      const std::vector<TimedMidi>& midi);
 
 private:
     struct Impl;
