@@ -472,7 +472,10 @@ void Synth::updateControl(Voice& v) noexcept
     v.targetPeriod = fs_ / noteFrequency(v.pitch + bend);
     const double intonation = params_[static_cast<int>(Param::Intonation)];
     v.frequency = noteFrequency(v.pitch + bend + vibrato + intonation * v.correctionCents / 100.0);
-    v.strings[static_cast<std::size_t>(v.stringIndex)].waveguide().setFundamental(v.frequency);
+    // Re-stopping redesigns the loss filters: skip moves below 0.02 cent (the ear's correction
+    // creeps by less than that between periods once it has settled).
+    auto& waveguide = v.strings[static_cast<std::size_t>(v.stringIndex)].waveguide();
+    if (std::abs(v.frequency - waveguide.fundamental()) > 1e-5 * v.frequency) waveguide.setFundamental(v.frequency);
 }
 
 void Synth::renderVoice(Voice& v, float* busL, float* busR, int n) noexcept

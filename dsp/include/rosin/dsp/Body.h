@@ -23,49 +23,60 @@ struct BodyParams {
 };
 
 /// Parallel second-order resonators in topology-preserving (trapezoidal) state-variable form:
-/// stable for any coefficient, and their band-pass output peaks at exactly `gain`.
+/// stable for any coefficient, and their band-pass output peaks at exactly `gain`. The modes
+/// are independent, so they are stored lane by lane and stepped in 16-byte vector packs.
 template <typename T>
 class ModalBody {
+    typedef T Pack __attribute__((vector_size(16)));
+    static constexpr int lanes = static_cast<int>(16 / sizeof(T));
+    static constexpr int maxPacks = (BodyParams::maxModes + lanes - 1) / lanes;
+
 public:
     /// [setup thread] No allocation: the mode array is fixed.
     void prepare(double sampleRate, const BodyParams& params) noexcept
     {
-        fs_ = sampleRate;
         params_ = params;
-        count_ = std::clamp(params.count, 0, BodyParams::maxModes);
         active_ = 0;
-        for (int i = 0; i < count_; ++i) {
+        for (int p = 0; p < maxPacks; ++p) g_[p] = k_[p] = a1_[p] = gain_[p] = Pack{};
+        const int count = std::clamp(params.count, 0, BodyParams::maxModes);
+        for (int i = 0; i < count; ++i) {
             const BodyMode& m = params.modes[static_cast<std::size_t>(i)];
             if (!(m.frequency > 0.0) || m.frequency >= 0.49 * sampleRate || !(m.q > 0.0)) continue;
-            Section& s = sections_[static_cast<std::size_t>(active_++)];
             const double g = std::tan(std::numbers::pi * m.frequency / sampleRate);
             const double k = 1.0 / m.q;
-            s.g = static_cast<T>(g);
-            s.k = static_cast<T>(k);
-            s.a1 = static_cast<T>(1.0 / (1.0 + g * (g + k)));
-            s.gain = static_cast<T>(m.gain * k); // band-pass peak is 1/k: scale it to `gain`
+            const int pack = active_ / lanes, lane = active_ % lanes;
+            g_[pack][lane] = static_cast<T>(g);
+            k_[pack][lane] = static_cast<T>(k);
+            a1_[pack][lane] = static_cast<T>(1.0 / (1.0 + g * (g + k)));
+            gain_[pack][lane] = static_cast<T>(m.gain * k); // band-pass peak is 1/k: scale it to `gain`
+            ++active_;
         }
+        packs_ = (active_ + lanes - 1) / lanes;
+        direct_ = static_cast<T>(params.direct);
+        scale_ = static_cast<T>(params.outputScale);
         reset();
     }
 
     void reset() noexcept
     {
-        for (auto& s : sections_) s.ic1 = s.ic2 = T(0);
+        for (int p = 0; p < maxPacks; ++p) ic1_[p] = ic2_[p] = Pack{};
     }
 
     /// [audio thread] Bridge force in, body output out (scaled by outputScale).
     T processSample(T force) noexcept
     {
-        T y = static_cast<T>(params_.direct) * force;
-        for (int i = 0; i < active_; ++i) {
-            Section& s = sections_[static_cast<std::size_t>(i)];
-            const T v1 = s.a1 * (s.ic1 + s.g * (force - s.ic2));
-            const T v2 = s.ic2 + s.g * v1;
-            s.ic1 = T(2) * v1 - s.ic1;
-            s.ic2 = T(2) * v2 - s.ic2;
-            y += s.gain * v1;
+        const Pack x = Pack{} + force;
+        Pack sum{};
+        for (int p = 0; p < packs_; ++p) {
+            const Pack v1 = a1_[p] * (ic1_[p] + g_[p] * (x - ic2_[p]));
+            const Pack v2 = ic2_[p] + g_[p] * v1;
+            ic1_[p] = T(2) * v1 - ic1_[p];
+            ic2_[p] = T(2) * v2 - ic2_[p];
+            sum += gain_[p] * v1;
         }
-        return y * static_cast<T>(params_.outputScale);
+        T y = direct_ * force;
+        for (int l = 0; l < lanes; ++l) y += sum[l];
+        return y * scale_;
     }
 
     void processBlock(const T* in, T* out, int n) noexcept
@@ -77,13 +88,11 @@ public:
     const BodyParams& params() const noexcept { return params_; }
 
 private:
-    struct Section {
-        T g = T(0), k = T(1), a1 = T(1), gain = T(0), ic1 = T(0), ic2 = T(0);
-    };
-    double fs_ = 48000.0;
     BodyParams params_;
-    std::array<Section, BodyParams::maxModes> sections_{};
-    int count_ = 0, active_ = 0;
+    // Plain arrays: GCC drops the vector attribute inside std::array.
+    Pack g_[maxPacks]{}, k_[maxPacks]{}, a1_[maxPacks]{}, gain_[maxPacks]{}, ic1_[maxPacks]{}, ic2_[maxPacks]{};
+    T direct_ = T(0.2), scale_ = T(1);
+    int active_ = 0, packs_ = 0;
 };
 
 } // namespace rosin::dsp
