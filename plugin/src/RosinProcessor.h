@@ -14,7 +14,7 @@
 #include <memory>
 #include <mutex>
 
-#include "SpscQueue.h"
+#include "rosin/engine/SpscQueue.h"
 #include "rosin/engine/ControllerMap.h"
 #include "rosin/engine/Synth.h"
 
@@ -88,7 +88,7 @@ private:
 
     // Crossing threads.
     std::atomic<engine::Synth*> pending_{nullptr};
-    SpscQueue<engine::Synth*, 16> trash_;
+    engine::SpscQueue<engine::Synth*, 16> trash_;
     std::atomic<double> sampleRate_{0.0};
     std::atomic<int> loadedInstrument_{-1};   ///< index of the instrument whose Synth is installed or pending
     int installedInstrument_ = -1;            ///< [audio thread] index of current_'s instrument

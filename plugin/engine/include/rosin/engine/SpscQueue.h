@@ -5,7 +5,7 @@
 #include <atomic>
 #include <cstddef>
 
-namespace rosin::plugin {
+namespace rosin::engine {
 
 template <typename T, std::size_t Capacity>
 class SpscQueue {
@@ -38,4 +38,4 @@ private:
     alignas(64) std::atomic<std::size_t> tail_{0};
 };
 
-} // namespace rosin::plugin
+} // namespace rosin::engine

@@ -1,0 +1,90 @@
+// The HID input thread: finds a controller (hot-plug: devices come and go while playing), reads
+// its reports, decodes and maps them, and hands BowCommands to the audio thread through a
+// lock-free SPSC queue. The device layer is an interface so tests drive it with a fake device;
+// HidapiBackend is the real one (hidapi's hidraw backend; descriptors from sysfs).
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rosin/engine/SpscQueue.h"
+#include "rosin/hid/Mapping.h"
+
+namespace rosin::hid {
+
+struct DeviceInfo {
+    std::string path;          ///< /dev/hidrawN for hidapi's hidraw backend
+    std::uint16_t vendor = 0, product = 0;
+    std::string name;
+};
+
+class DeviceHandle {
+public:
+    virtual ~DeviceHandle() = default;
+    /// Up to `size` bytes of one input report; 0 on timeout; < 0 when the device is gone.
+    virtual int read(std::uint8_t* buffer, std::size_t size, int timeoutMs) = 0;
+    virtual std::vector<std::uint8_t> descriptor() = 0; ///< empty when it cannot be read
+};
+
+class DeviceBackend {
+public:
+    virtual ~DeviceBackend() = default;
+    virtual std::vector<DeviceInfo> enumerate() = 0;
+    /// nullptr with `error` set (e.g. permission denied: the udev rule is missing).
+    virtual std::unique_ptr<DeviceHandle> open(const DeviceInfo& info, std::string& error) = 0;
+};
+
+/// hidapi (hidraw). The report descriptor comes from /sys/class/hidraw/hidrawN/device/report_descriptor.
+std::unique_ptr<DeviceBackend> makeHidapiBackend();
+
+class HidInput {
+public:
+    using Queue = engine::SpscQueue<BowCommand, 1024>;
+
+    explicit HidInput(std::unique_ptr<DeviceBackend> backend);
+    ~HidInput();
+
+    /// [message thread] Mapping per device kind (the one used when such a device is opened).
+    void setMapping(const HidMapping& m);
+    HidMapping mapping(DeviceKind kind) const;
+    /// Only devices with this vendor:product (0 = any recognised controller).
+    void setFilter(std::uint16_t vendor, std::uint16_t product);
+
+    void start();
+    void stop();
+    bool running() const { return running_.load(); }
+
+    /// [audio thread] Drain: the latest command wins for the bow; every note trigger counts.
+    Queue& queue() { return queue_; }
+
+    /// What the thread is doing, for people: "no controller", "Wacom ... (tablet)", "... unplugged",
+    /// "cannot open ...: permission denied (install the udev rule)".
+    std::string status() const;
+    std::uint64_t reportsRead() const { return reports_.load(); }
+    int connections() const { return connections_.load(); }
+
+    double rescanSeconds = 0.5;
+
+private:
+    void run();
+    void setStatus(const std::string& s);
+    bool push(const BowCommand& c);
+
+    std::unique_ptr<DeviceBackend> backend_;
+    Queue queue_;
+    std::thread thread_;
+    std::atomic<bool> running_{false}, stopRequested_{false};
+    std::atomic<std::uint64_t> reports_{0};
+    std::atomic<int> connections_{0};
+    mutable std::mutex mutex_; ///< guards status_, mappings_ and the filter (never the audio thread)
+    std::string status_ = "stopped";
+    std::vector<HidMapping> mappings_;
+    std::uint16_t filterVendor_ = 0, filterProduct_ = 0;
+};
+
+} // namespace rosin::hid

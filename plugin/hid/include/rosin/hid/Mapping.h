@@ -1,0 +1,136 @@
+// From a HID device to the bow: device profiles (tablet, gamepad, 3D mouse, joystick), the
+// normalised device state, editable curves, calibration, and the mapper that turns the state
+// into bow force (N), bow speed (m/s, signed: its sign is the bow direction), bow position
+// (beta), string selection and note triggers. No JUCE; runs on the HID thread.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "rosin/hid/Descriptor.h"
+
+namespace rosin::hid {
+
+enum class DeviceKind { Tablet, Gamepad, SpaceMouse, Joystick, Other };
+const char* kindName(DeviceKind k);
+DeviceKind parseKind(const std::string& name); ///< throws std::runtime_error on an unknown name
+DeviceKind classify(const Descriptor& d);
+
+/// Known descriptor errors (CONTROLLERS.md 1.2): hidraw gives the unfixed reports.
+struct Quirks {
+    bool forceAbsolute = false;   ///< axes flagged Relative that carry absolute data (SpaceNavigator)
+    double hatDegreesPerStep = 0; ///< a hat whose logical range does not match its physical one
+};
+Quirks quirksFor(std::uint16_t vendor, std::uint16_t product);
+
+/// Everything the mapping reads, normalised. Split reports (3D mouse) hold their last values.
+struct DeviceState {
+    bool tip = false, inRange = false;
+    double pressure = 0.0, x = 0.5, y = 0.5, tiltX = 0.0, tiltY = 0.0; ///< tablet: 0..1, tilt -1..1
+    /// Generic desktop X, Y, Z, Rx, Ry, Rz, Slider: -1..1 (sticks centred, signed axes as sent).
+    std::array<double, 7> axes{};
+    double triggerL = 0.0, triggerR = 0.0; ///< 0..1
+    std::uint64_t buttons = 0;             ///< bit n-1 = button n
+    int hat = -1;                          ///< 0..7 clockwise from up, -1 released
+};
+
+/// Decodes one device's input reports into a DeviceState.
+class DeviceDecoder {
+public:
+    DeviceDecoder() = default;
+    DeviceDecoder(Descriptor descriptor, Quirks quirks);
+    /// One report as hidraw delivers it. False (state untouched) when the report is unknown or short.
+    bool apply(const std::uint8_t* report, std::size_t size, DeviceState& state) const;
+    const Descriptor& descriptor() const { return descriptor_; }
+    DeviceKind kind() const { return kind_; }
+
+private:
+    Descriptor descriptor_;
+    Quirks quirks_;
+    DeviceKind kind_ = DeviceKind::Other;
+};
+
+enum class Source {
+    None, Pressure, X, Y, TiltX, TiltY, AxisX, AxisY, AxisZ, AxisRx, AxisRy, AxisRz, Slider, TriggerL, TriggerR
+};
+const char* sourceName(Source s);
+Source parseSource(const std::string& name); ///< throws std::runtime_error on an unknown name
+double read(const DeviceState& s, Source src);
+
+/// in -> out: normalise over [inMin, inMax], dead zone, invert, power curve, then [outMin, outMax].
+struct Curve {
+    double inMin = 0.0, inMax = 1.0, outMin = 0.0, outMax = 1.0;
+    double exponent = 1.0; ///< > 1 is soft at the start (a light touch stays light)
+    double deadzone = 0.0; ///< fraction of the input range treated as 0
+    bool invert = false;
+    double operator()(double x) const;
+};
+
+struct HidMapping {
+    std::string name = "tablet";
+    DeviceKind kind = DeviceKind::Tablet;
+    Source force = Source::Pressure;
+    Curve forceCurve{0.0, 1.0, 0.0, 2.5, 1.5};      ///< N
+    Source speed = Source::X;
+    bool speedFromMotion = true;                    ///< speed = d(source)/dt x speedScale (tablets)
+    double speedScale = 0.22;                       ///< m/s per (full range)/s: a 22 cm wide tablet
+    Curve speedCurve{-1.0, 1.0, -0.6, 0.6, 1.0, 0.08}; ///< direct sources (sticks): m/s
+    double speedSmoothing = 0.03;                   ///< s (the derivative of ~100-1000 Hz reports)
+    Source position = Source::Y;
+    Curve positionCurve{0.0, 1.0, 0.03, 0.25};      ///< beta
+    Source stringSelect = Source::TiltX;
+    Curve stringCurve{-0.6, 0.6, 0.0, 1.0};         ///< 0..1 split evenly over the strings
+    int strings = 4;
+    bool requireTip = true;                         ///< tablets: the bow is on the string while the pen touches
+    int tipNote = 50;                               ///< note played while the pen touches (-1: none, keyboard plays)
+    std::array<int, 8> buttonNotes{-1, -1, -1, -1, -1, -1, -1, -1}; ///< button n+1 holds this note
+    double bowChangeThreshold = 0.02;               ///< m/s: a sign change beyond this is a bow change
+
+    static HidMapping defaultFor(DeviceKind kind);
+    std::string toJson() const;
+    /// From JSON (rosin-hid/1). Throws std::runtime_error naming `where` and the field.
+    static HidMapping fromJson(const std::string& text, const std::string& where);
+};
+
+/// What the HID thread sends to the audio thread (through the SPSC queue).
+struct BowCommand {
+    double seconds = 0.0;
+    float force = 0.0f, speed = 0.0f, beta = 0.1f; ///< N, m/s (signed), fraction of the string
+    int string = -1;                               ///< selected string, -1 none
+    bool engaged = false;                          ///< the bow is on the string
+    bool bowChange = false;                        ///< the direction flipped at this command
+    std::int8_t noteOn = -1, noteOff = -1;         ///< note triggers (MIDI numbers)
+    std::int8_t noteOn2 = -1, noteOff2 = -1;       ///< a second trigger in the same report
+};
+
+/// Observes min/max of every source while calibrating; applies them as curve input ranges.
+class Calibration {
+public:
+    void reset();
+    void observe(const DeviceState& s);
+    void apply(HidMapping& m) const; ///< only sources that moved by more than 5 % of their range
+private:
+    std::array<double, 15> lo_{}, hi_{};
+    bool seen_ = false;
+};
+
+class BowMapper {
+public:
+    explicit BowMapper(HidMapping mapping = {}) : mapping_(std::move(mapping)) {}
+    const HidMapping& mapping() const { return mapping_; }
+    void setMapping(const HidMapping& m) { mapping_ = m; }
+    void reset();
+    /// The bow after this state at this time (seconds, monotonic).
+    BowCommand update(const DeviceState& s, double seconds);
+    /// The release sent when the device disappears mid-note.
+    BowCommand release(double seconds);
+
+private:
+    HidMapping mapping_;
+    bool haveLast_ = false, wasEngaged_ = false;
+    double lastTime_ = 0.0, lastCoord_ = 0.0, speed_ = 0.0;
+    int direction_ = 0, heldTipNote_ = -1;
+    std::uint64_t lastButtons_ = 0;
+};
+
+} // namespace rosin::hid

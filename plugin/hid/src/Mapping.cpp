@@ -1,0 +1,441 @@
+#include "rosin/hid/Mapping.h"
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+namespace rosin::hid {
+namespace {
+constexpr std::array<const char*, 15> sourceNames{"none", "pressure", "x", "y", "tilt_x", "tilt_y", "axis_x", "axis_y",
+                                                  "axis_z", "axis_rx", "axis_ry", "axis_rz", "slider", "trigger_l", "trigger_r"};
+constexpr std::array<const char*, 5> kindNames{"tablet", "gamepad", "spacemouse", "joystick", "other"};
+
+bool hasApplication(const Descriptor& d, Usage u)
+{
+    return std::find(d.applications.begin(), d.applications.end(), u) != d.applications.end();
+}
+} // namespace
+
+const char* kindName(DeviceKind k) { return kindNames[static_cast<std::size_t>(k)]; }
+
+DeviceKind parseKind(const std::string& name)
+{
+    for (std::size_t i = 0; i < kindNames.size(); ++i)
+        if (name == kindNames[i]) return static_cast<DeviceKind>(i);
+    throw std::runtime_error("unknown device kind '" + name + "' (tablet, gamepad, spacemouse, joystick, other)");
+}
+
+DeviceKind classify(const Descriptor& d)
+{
+    if (hasApplication(d, usages::digitizer) || hasApplication(d, usages::pen) || d.findInput(usages::tipPressure))
+        return DeviceKind::Tablet;
+    if (hasApplication(d, usages::gamepad)) return DeviceKind::Gamepad;
+    if (hasApplication(d, usages::multiAxis)) return DeviceKind::SpaceMouse;
+    if (hasApplication(d, usages::joystick)) return DeviceKind::Joystick;
+    return DeviceKind::Other;
+}
+
+Quirks quirksFor(std::uint16_t vendor, std::uint16_t product)
+{
+    Quirks q;
+    if (vendor == 0x046D && (product == 0xC626 || product == 0xC627 || product == 0xC628)) q.forceAbsolute = true; // 3Dconnexion on Logitech IDs
+    if (vendor == 0x256F) q.forceAbsolute = true;                            // 3Dconnexion's own VID
+    if (vendor == 0x11C0 && product == 0x5606) q.hatDegreesPerStep = 360.0 / 240.0; // Raptor MACH 2: 0..239 over 360 degrees
+    return q;
+}
+
+DeviceDecoder::DeviceDecoder(Descriptor descriptor, Quirks quirks)
+    : descriptor_(std::move(descriptor)), quirks_(quirks), kind_(classify(descriptor_))
+{
+}
+
+bool DeviceDecoder::apply(const std::uint8_t* report, std::size_t size, DeviceState& s) const
+{
+    if (report == nullptr || size == 0) return false;
+    int id = 0;
+    const std::uint8_t* payload = report;
+    std::size_t payloadSize = size;
+    if (descriptor_.numbered) {
+        id = report[0];
+        ++payload;
+        --payloadSize;
+    }
+    const ReportInfo* info = descriptor_.report(ReportType::Input, id);
+    if (info == nullptr || payloadSize < static_cast<std::size_t>(info->bytes())) return false;
+    const bool tablet = kind_ == DeviceKind::Tablet;
+    bool sawTriggers = false;
+    for (const Field& f : descriptor_.fields) {
+        if (f.type != ReportType::Input || f.reportId != id || f.constant()) continue;
+        const std::int64_t raw = extractRaw(f, payload, payloadSize);
+        if (!f.variable()) { // array: the value names a usage (buttons pressed, keys)
+            if (raw < f.logicalMin || raw > f.logicalMax) continue;
+            const Usage u = f.usage + static_cast<Usage>(raw - f.logicalMin);
+            if (usagePage(u) == 0x09 && usageId(u) >= 1 && usageId(u) <= 64) s.buttons |= 1ull << (usageId(u) - 1);
+            continue;
+        }
+        const double n = normalisedValue(f, raw);
+        const double centred = f.isSigned() ? n : 2.0 * n - 1.0;
+        auto axis = [&](int index) {
+            double& a = s.axes[static_cast<std::size_t>(index)];
+            if (f.relative() && !quirks_.forceAbsolute) a = std::clamp(a + 0.01 * static_cast<double>(raw), -1.0, 1.0);
+            else a = centred;
+        };
+        switch (f.usage) {
+        case usages::tipPressure: s.pressure = n; break;
+        case usages::tipSwitch: s.tip = raw != 0; break;
+        case usages::inRange: s.inRange = raw != 0; break;
+        case usages::xTilt: s.tiltX = f.isSigned() ? n : 2.0 * n - 1.0; break;
+        case usages::yTilt: s.tiltY = f.isSigned() ? n : 2.0 * n - 1.0; break;
+        case usages::x: if (tablet) s.x = n; else axis(0); break;
+        case usages::y: if (tablet) s.y = n; else axis(1); break;
+        case usages::z: axis(2); break;
+        case usages::rx: axis(3); break;
+        case usages::ry: axis(4); break;
+        case usages::rz: axis(5); break;
+        case usages::slider: axis(6); break;
+        case usages::brake: s.triggerL = n; sawTriggers = true; break;
+        case usages::accelerator: s.triggerR = n; sawTriggers = true; break;
+        case usages::hat:
+            if (isNull(f, raw)) s.hat = -1;
+            else if (quirks_.hatDegreesPerStep > 0) s.hat = static_cast<int>(std::lround(raw * quirks_.hatDegreesPerStep / 45.0)) % 8;
+            else s.hat = static_cast<int>(raw - f.logicalMin) % 8;
+            break;
+        default:
+            if (usagePage(f.usage) == 0x09 && f.bitSize == 1) {
+                const int b = usageId(f.usage);
+                if (b >= 1 && b <= 64) {
+                    if (raw) s.buttons |= 1ull << (b - 1);
+                    else s.buttons &= ~(1ull << (b - 1));
+                }
+            }
+            break;
+        }
+    }
+    // A DualShock 4 reports its analog triggers as Rx/Ry (sticks are X/Y/Z/Rz).
+    if (kind_ == DeviceKind::Gamepad && !sawTriggers && descriptor_.find(ReportType::Input, id, usages::rx)) {
+        s.triggerL = 0.5 * (s.axes[3] + 1.0);
+        s.triggerR = 0.5 * (s.axes[4] + 1.0);
+    }
+    return true;
+}
+
+const char* sourceName(Source s) { return sourceNames[static_cast<std::size_t>(s)]; }
+
+Source parseSource(const std::string& name)
+{
+    for (std::size_t i = 0; i < sourceNames.size(); ++i)
+        if (name == sourceNames[i]) return static_cast<Source>(i);
+    throw std::runtime_error("unknown source '" + name + "'");
+}
+
+double read(const DeviceState& s, Source src)
+{
+    switch (src) {
+    case Source::None: return 0.0;
+    case Source::Pressure: return s.pressure;
+    case Source::X: return s.x;
+    case Source::Y: return s.y;
+    case Source::TiltX: return s.tiltX;
+    case Source::TiltY: return s.tiltY;
+    case Source::AxisX: return s.axes[0];
+    case Source::AxisY: return s.axes[1];
+    case Source::AxisZ: return s.axes[2];
+    case Source::AxisRx: return s.axes[3];
+    case Source::AxisRy: return s.axes[4];
+    case Source::AxisRz: return s.axes[5];
+    case Source::Slider: return s.axes[6];
+    case Source::TriggerL: return s.triggerL;
+    case Source::TriggerR: return s.triggerR;
+    }
+    return 0.0;
+}
+
+double Curve::operator()(double x) const
+{
+    if (!std::isfinite(x)) x = inMin;
+    const double span = inMax - inMin;
+    double t = span != 0.0 ? (x - inMin) / span : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    if (invert) t = 1.0 - t;
+    // A symmetric range (a centred stick) has its dead zone around the middle; else at the start.
+    const bool centred = inMin < 0.0 && inMax > 0.0;
+    if (centred) {
+        double c = 2.0 * t - 1.0;
+        const double a = std::abs(c);
+        c = a <= deadzone ? 0.0 : std::copysign(std::pow((a - deadzone) / (1.0 - deadzone), exponent), c);
+        t = 0.5 * (c + 1.0);
+    } else {
+        t = t <= deadzone ? 0.0 : std::pow((t - deadzone) / (1.0 - deadzone), exponent);
+    }
+    return outMin + t * (outMax - outMin);
+}
+
+HidMapping HidMapping::defaultFor(DeviceKind kind)
+{
+    HidMapping m;
+    m.kind = kind;
+    m.name = kindName(kind);
+    switch (kind) {
+    case DeviceKind::Tablet: break; // the struct defaults are the tablet (CONTROLLERS.md 5)
+    case DeviceKind::Gamepad:
+        m.force = Source::TriggerR;
+        m.forceCurve = {0.0, 1.0, 0.0, 2.5, 1.5, 0.03};
+        m.speed = Source::AxisX;
+        m.speedFromMotion = false;
+        m.position = Source::AxisY;
+        m.positionCurve = {-1.0, 1.0, 0.03, 0.25};
+        m.stringSelect = Source::None;
+        m.requireTip = false;
+        m.tipNote = -1;
+        m.buttonNotes = {43, 50, 57, 64, -1, -1, -1, -1};
+        break;
+    case DeviceKind::SpaceMouse:
+        m.force = Source::AxisZ;
+        m.forceCurve = {-1.0, 0.0, 0.0, 2.5, 1.5, 0.05, true}; // push down (negative Z) = more force
+        m.speed = Source::AxisX;
+        m.speedFromMotion = false;
+        m.position = Source::AxisY;
+        m.positionCurve = {-1.0, 1.0, 0.03, 0.25};
+        m.stringSelect = Source::None;
+        m.requireTip = false;
+        m.tipNote = -1;
+        m.buttonNotes = {50, 57, -1, -1, -1, -1, -1, -1};
+        break;
+    case DeviceKind::Joystick:
+        m.force = Source::AxisY;
+        m.forceCurve = {-1.0, 1.0, 0.0, 2.5, 1.5, 0.0, true}; // pull back = more force
+        m.speed = Source::AxisX;
+        m.speedFromMotion = false;
+        m.position = Source::Slider;
+        m.positionCurve = {-1.0, 1.0, 0.03, 0.25};
+        m.stringSelect = Source::None;
+        m.requireTip = false;
+        m.tipNote = -1;
+        m.buttonNotes = {50, 57, -1, -1, -1, -1, -1, -1};
+        break;
+    case DeviceKind::Other: m.force = Source::None; m.requireTip = false; m.tipNote = -1; break;
+    }
+    return m;
+}
+
+namespace {
+nlohmann::json curveJson(const Curve& c)
+{
+    return {{"in", {c.inMin, c.inMax}}, {"out", {c.outMin, c.outMax}}, {"exponent", c.exponent},
+            {"deadzone", c.deadzone}, {"invert", c.invert}};
+}
+
+Curve curveFrom(const nlohmann::json& j, const std::string& where, Curve c)
+{
+    if (!j.is_object()) throw std::runtime_error(where + " must be an object");
+    auto pair = [&](const char* key, double& a, double& b) {
+        if (!j.contains(key)) return;
+        const auto& v = j[key];
+        if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+            throw std::runtime_error(where + "." + key + " must be [low, high]");
+        a = v[0].get<double>();
+        b = v[1].get<double>();
+        if (!std::isfinite(a) || !std::isfinite(b)) throw std::runtime_error(where + "." + key + " must be finite");
+    };
+    pair("in", c.inMin, c.inMax);
+    pair("out", c.outMin, c.outMax);
+    if (c.inMin == c.inMax) throw std::runtime_error(where + ".in must span a range");
+    if (j.contains("exponent")) {
+        if (!j["exponent"].is_number() || !(j["exponent"].get<double>() > 0.0) || j["exponent"].get<double>() > 10.0)
+            throw std::runtime_error(where + ".exponent must be in (0, 10]");
+        c.exponent = j["exponent"].get<double>();
+    }
+    if (j.contains("deadzone")) {
+        if (!j["deadzone"].is_number() || j["deadzone"].get<double>() < 0.0 || j["deadzone"].get<double>() >= 1.0)
+            throw std::runtime_error(where + ".deadzone must be in [0, 1)");
+        c.deadzone = j["deadzone"].get<double>();
+    }
+    if (j.contains("invert")) {
+        if (!j["invert"].is_boolean()) throw std::runtime_error(where + ".invert must be true or false");
+        c.invert = j["invert"].get<bool>();
+    }
+    return c;
+}
+} // namespace
+
+std::string HidMapping::toJson() const
+{
+    nlohmann::json j{{"format", "rosin-hid/1"},
+                     {"name", name},
+                     {"device", kindName(kind)},
+                     {"force", {{"source", sourceName(force)}, {"curve", curveJson(forceCurve)}}},
+                     {"speed", {{"source", sourceName(speed)}, {"from_motion", speedFromMotion}, {"scale_m", speedScale},
+                                {"curve", curveJson(speedCurve)}, {"smoothing_s", speedSmoothing},
+                                {"bow_change_m_s", bowChangeThreshold}}},
+                     {"position", {{"source", sourceName(position)}, {"curve", curveJson(positionCurve)}}},
+                     {"string", {{"source", sourceName(stringSelect)}, {"curve", curveJson(stringCurve)}, {"count", strings}}},
+                     {"require_tip", requireTip},
+                     {"tip_note", tipNote},
+                     {"button_notes", buttonNotes}};
+    return j.dump(2);
+}
+
+HidMapping HidMapping::fromJson(const std::string& text, const std::string& where)
+{
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(text);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw std::runtime_error(where + ": not valid JSON (" + e.what() + ")");
+    }
+    auto fail = [&](const std::string& what) -> std::runtime_error { return std::runtime_error(where + ": " + what); };
+    if (!j.is_object() || j.value("format", "") != "rosin-hid/1") throw fail("field 'format' must be 'rosin-hid/1'");
+    if (!j.contains("device") || !j["device"].is_string()) throw fail("field 'device' is missing");
+    HidMapping m;
+    try {
+        m = defaultFor(parseKind(j["device"].get<std::string>()));
+        if (j.contains("name")) m.name = j["name"].get<std::string>();
+        auto section = [&](const char* key, Source& src, Curve& curve) {
+            if (!j.contains(key)) return;
+            const auto& s = j[key];
+            if (s.contains("source")) src = parseSource(s["source"].get<std::string>());
+            if (s.contains("curve")) curve = curveFrom(s["curve"], std::string(key) + ".curve", curve);
+        };
+        section("force", m.force, m.forceCurve);
+        section("speed", m.speed, m.speedCurve);
+        section("position", m.position, m.positionCurve);
+        section("string", m.stringSelect, m.stringCurve);
+        if (j.contains("speed")) {
+            const auto& s = j["speed"];
+            m.speedFromMotion = s.value("from_motion", m.speedFromMotion);
+            m.speedScale = s.value("scale_m", m.speedScale);
+            m.speedSmoothing = s.value("smoothing_s", m.speedSmoothing);
+            m.bowChangeThreshold = s.value("bow_change_m_s", m.bowChangeThreshold);
+            if (!(m.speedScale > 0.0 && m.speedScale < 10.0)) throw std::runtime_error("speed.scale_m must be in (0, 10)");
+            if (!(m.speedSmoothing >= 0.0 && m.speedSmoothing < 1.0)) throw std::runtime_error("speed.smoothing_s must be in [0, 1)");
+        }
+        if (j.contains("string")) m.strings = std::clamp(j["string"].value("count", m.strings), 1, 5);
+        m.requireTip = j.value("require_tip", m.requireTip);
+        m.tipNote = std::clamp(j.value("tip_note", m.tipNote), -1, 127);
+        if (j.contains("button_notes")) {
+            const auto& b = j["button_notes"];
+            if (!b.is_array() || b.size() > m.buttonNotes.size()) throw std::runtime_error("button_notes must be an array of up to 8 notes");
+            m.buttonNotes.fill(-1);
+            for (std::size_t i = 0; i < b.size(); ++i) m.buttonNotes[i] = std::clamp(b[i].get<int>(), -1, 127);
+        }
+    } catch (const nlohmann::json::exception& e) {
+        throw fail(std::string("a field has the wrong type (") + e.what() + ")");
+    } catch (const std::runtime_error& e) {
+        throw fail(e.what());
+    }
+    return m;
+}
+
+void Calibration::reset()
+{
+    lo_.fill(1e300);
+    hi_.fill(-1e300);
+    seen_ = false;
+}
+
+void Calibration::observe(const DeviceState& s)
+{
+    if (!seen_) reset();
+    seen_ = true;
+    for (std::size_t i = 1; i < lo_.size(); ++i) {
+        const double v = read(s, static_cast<Source>(i));
+        lo_[i] = std::min(lo_[i], v);
+        hi_[i] = std::max(hi_[i], v);
+    }
+}
+
+void Calibration::apply(HidMapping& m) const
+{
+    if (!seen_) return;
+    auto fit = [&](Source src, Curve& c) {
+        const auto i = static_cast<std::size_t>(src);
+        if (src == Source::None || hi_[i] - lo_[i] < 0.05 * std::abs(c.inMax - c.inMin)) return;
+        c.inMin = lo_[i];
+        c.inMax = hi_[i];
+    };
+    fit(m.force, m.forceCurve);
+    fit(m.position, m.positionCurve);
+    if (!m.speedFromMotion) fit(m.speed, m.speedCurve);
+}
+
+void BowMapper::reset()
+{
+    haveLast_ = wasEngaged_ = false;
+    speed_ = 0.0;
+    direction_ = 0;
+    heldTipNote_ = -1;
+    lastButtons_ = 0;
+}
+
+BowCommand BowMapper::update(const DeviceState& s, double seconds)
+{
+    const HidMapping& m = mapping_;
+    BowCommand c;
+    c.seconds = seconds;
+    const double force = m.force == Source::None ? 0.0 : m.forceCurve(read(s, m.force));
+    c.engaged = m.requireTip ? (s.tip || (s.inRange && s.pressure > 0.0)) : force > 1e-4;
+
+    if (m.speedFromMotion) {
+        const double coord = read(s, m.speed);
+        if (haveLast_ && seconds > lastTime_) {
+            const double dt = seconds - lastTime_;
+            const double raw = (coord - lastCoord_) / dt * m.speedScale;
+            const double a = m.speedSmoothing > 0.0 ? 1.0 - std::exp(-dt / m.speedSmoothing) : 1.0;
+            speed_ += a * (raw - speed_);
+        }
+        lastCoord_ = coord;
+    } else {
+        speed_ = m.speed == Source::None ? 0.0 : m.speedCurve(read(s, m.speed));
+    }
+    haveLast_ = true;
+    lastTime_ = seconds;
+
+    const int dir = speed_ > m.bowChangeThreshold ? 1 : speed_ < -m.bowChangeThreshold ? -1 : 0;
+    if (dir != 0) {
+        c.bowChange = direction_ != 0 && dir != direction_ && c.engaged;
+        direction_ = dir;
+    }
+    c.force = static_cast<float>(c.engaged ? force : 0.0);
+    c.speed = static_cast<float>(std::clamp(speed_, -5.0, 5.0));
+    c.beta = static_cast<float>(m.position == Source::None ? 0.1 : std::clamp(m.positionCurve(read(s, m.position)), 0.02, 0.3));
+    if (m.stringSelect != Source::None && m.strings > 0)
+        c.string = std::clamp(static_cast<int>(m.stringCurve(read(s, m.stringSelect)) * m.strings), 0, m.strings - 1);
+
+    auto trigger = [&](bool on, int note) {
+        if (note < 0) return;
+        std::int8_t& slot = on ? (c.noteOn < 0 ? c.noteOn : c.noteOn2) : (c.noteOff < 0 ? c.noteOff : c.noteOff2);
+        slot = static_cast<std::int8_t>(note);
+    };
+    if (c.engaged && !wasEngaged_ && m.tipNote >= 0 && m.requireTip) {
+        heldTipNote_ = m.tipNote;
+        trigger(true, heldTipNote_);
+    }
+    if (!c.engaged && wasEngaged_ && heldTipNote_ >= 0) {
+        trigger(false, heldTipNote_);
+        heldTipNote_ = -1;
+    }
+    for (std::size_t b = 0; b < m.buttonNotes.size(); ++b) {
+        const bool now = s.buttons & (1ull << b), before = lastButtons_ & (1ull << b);
+        if (now != before) trigger(now, m.buttonNotes[b]);
+    }
+    lastButtons_ = s.buttons;
+    wasEngaged_ = c.engaged;
+    return c;
+}
+
+BowCommand BowMapper::release(double seconds)
+{
+    BowCommand c;
+    c.seconds = seconds;
+    c.engaged = false;
+    if (heldTipNote_ >= 0) c.noteOff = static_cast<std::int8_t>(heldTipNote_);
+    for (std::size_t b = 0; b < mapping_.buttonNotes.size(); ++b)
+        if ((lastButtons_ & (1ull << b)) && mapping_.buttonNotes[b] >= 0) {
+            (c.noteOff < 0 ? c.noteOff : c.noteOff2) = static_cast<std::int8_t>(mapping_.buttonNotes[b]);
+        }
+    reset();
+    return c;
+}
+
+} // namespace rosin::hid
