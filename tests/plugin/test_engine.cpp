@@ -326,3 +326,37 @@ TEST(EngineRobustness, FrictionModelSwitchMidNoteKeepsTheNoteSounding)
         EXPECT_LT(std::abs(test::cents(test::pitchHz(out, fs, fs / 8, fs / 2), test::midiToHz(50))), 10.0) << m;
     }
 }
+
+TEST(EngineExternalBow, AControllerBowReplacesTheNominalAndMayReverse)
+{
+    auto s = makeSynth("cello");
+    ExternalBow bow;
+    bow.active = bow.engaged = true;
+    bow.force = 1.2f;
+    bow.speed = 0.2f;
+    bow.beta = 0.12f;
+    bow.string = 1; // G string: D3 played there, not on the open D
+    s->setExternalBow(bow);
+    const int fs = 48000;
+    const auto down = mono(render(*s, fs / 2, {on(0, 50)}));
+    VoiceInfo v = s->voiceInfo(0);
+    EXPECT_EQ(v.stringIndex, 1);
+    EXPECT_NEAR(v.force, 1.2, 1e-3);
+    EXPECT_NEAR(v.speed, 0.2, 1e-3);
+    EXPECT_NEAR(v.beta, 0.12, 1e-3);
+    EXPECT_GT(test::rms(down, fs / 4, fs / 2), 1e-2);
+    bow.speed = -0.2f; // bow change
+    s->setExternalBow(bow);
+    const auto up = mono(render(*s, fs / 2, {}));
+    EXPECT_NEAR(s->voiceInfo(0).speed, -0.2, 1e-3);
+    EXPECT_GT(test::rms(up, fs / 4, fs / 2), 1e-2);
+    EXPECT_LT(std::abs(test::cents(test::pitchHz(up, fs, fs / 4, fs / 2), test::midiToHz(50))), 10.0);
+    bow.engaged = false; // lifted: no force, the string rings down
+    s->setExternalBow(bow);
+    render(*s, fs / 10, {});
+    EXPECT_NEAR(s->voiceInfo(0).force, 0.0, 1e-3);
+    bow.force = NAN;
+    bow.speed = INFINITY;
+    s->setExternalBow(bow);
+    EXPECT_TRUE(std::isfinite(s->externalBow().force) && std::isfinite(s->externalBow().speed));
+}

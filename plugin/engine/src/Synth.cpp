@@ -129,6 +129,7 @@ int Synth::chooseString(double frequency, int preferred, unsigned occupiedMask) 
     const double flat = std::exp2(-0.5 / 12.0); // a quarter-tone flat still counts as this string
     auto open = [&](int s) { return instrument_.strings[static_cast<std::size_t>(s)].fundamental(); };
     auto reachable = [&](int s) { return s >= 0 && s < n && frequency >= open(s) * flat && frequency <= open(s) * top; };
+    if (external_.active && reachable(external_.string)) return external_.string; // the controller picked it
     const auto policy = static_cast<StringPolicy>(static_cast<int>(params_[static_cast<int>(Param::StringPolicy)]));
     if (policy == StringPolicy::StayOnString && reachable(preferred)) return preferred;
     if (policy == StringPolicy::FixedString) {
@@ -422,6 +423,17 @@ void Synth::releaseVoice(Voice& v) noexcept
     v.released = true;
 }
 
+void Synth::setExternalBow(const ExternalBow& bow) noexcept
+{
+    external_ = bow;
+    if (!std::isfinite(external_.force)) external_.force = 0.0f;
+    if (!std::isfinite(external_.speed)) external_.speed = 0.0f;
+    if (!std::isfinite(external_.beta)) external_.beta = 0.1f;
+    external_.force = std::clamp(external_.force, 0.0f, 20.0f);
+    external_.speed = std::clamp(external_.speed, -10.0f, 10.0f);
+    external_.beta = std::clamp(external_.beta, 0.02f, 0.3f);
+}
+
 void Synth::releaseAll() noexcept
 {
     for (auto& v : voices_)
@@ -444,13 +456,21 @@ void Synth::updateControl(Voice& v) noexcept
     float pressure = v.polyPressure >= 0.0f ? v.polyPressure : pick(c.pressure, m ? m->pressure : -1.0f);
     const float expression = pick(c.expression, m ? m->expression : -1.0f);
     const float position = pick(c.position, m ? m->position : -1.0f);
+    if (external_.active) { // the controller is the bow: its values, in newtons and m/s
+        v.targetForce = external_.engaged ? external_.force : 0.0;
+        v.targetSpeed = external_.speed;
+        v.beta += (external_.beta - v.beta) * betaSmoothing_;
+        pressure = -1.0f;
+    }
     const double forceScale = pressure < 0.0f ? 1.0 : 2.0 * pressure;
     const double speedScale = expression < 0.0f ? 1.0 : 2.0 * expression;
     const double betaScale = position < 0.0f ? 1.0 : std::exp2(2.0 * (position - 0.5));
-    v.targetForce = params_[static_cast<int>(Param::BowForce)] * forceScale;
-    v.targetSpeed = params_[static_cast<int>(Param::BowSpeed)] * speedScale;
-    const double betaTarget = std::clamp(params_[static_cast<int>(Param::BowPosition)] * betaScale, 0.02, 0.3);
-    v.beta += (betaTarget - v.beta) * betaSmoothing_;
+    if (!external_.active) {
+        v.targetForce = params_[static_cast<int>(Param::BowForce)] * forceScale;
+        v.targetSpeed = params_[static_cast<int>(Param::BowSpeed)] * speedScale;
+        const double betaTarget = std::clamp(params_[static_cast<int>(Param::BowPosition)] * betaScale, 0.02, 0.3);
+        v.beta += (betaTarget - v.beta) * betaSmoothing_;
+    }
     v.volume = (m ? m->volume : 1.0f) * c.volume;
 
     // Pitch: glide (portamento), bend (channel, plus the zone master's in MPE), vibrato.
@@ -491,10 +511,12 @@ void Synth::renderVoice(Voice& v, float* busL, float* busR, int n) noexcept
             updateControl(v);
             v.untilControl = controlInterval - 1;
         }
-        // Speed: Guettler's constant acceleration up to the target, then follow it smoothly.
-        if (v.speed < v.targetSpeed) v.speed = std::min(v.targetSpeed, v.speed + v.accel * dt);
+        // Speed: Guettler's constant acceleration up to the target, then follow it smoothly. A
+        // controller's hand is its own acceleration (and may reverse): follow it.
+        if (external_.active) v.speed += (v.targetSpeed - v.speed) * smoothing_;
+        else if (v.speed < v.targetSpeed) v.speed = std::min(v.targetSpeed, v.speed + v.accel * dt);
         else v.speed += (v.targetSpeed - v.speed) * smoothing_;
-        v.force += (v.targetForce * (1.0 + v.boost) - v.force) * smoothing_;
+        v.force += (v.targetForce * (external_.active ? 1.0 : 1.0 + v.boost) - v.force) * smoothing_;
         v.boost *= boostDecay;
         if (v.released) {
             if (v.lift > 0.0) v.lift = std::max(0.0, v.lift - liftStep);

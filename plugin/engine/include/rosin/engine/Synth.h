@@ -19,6 +19,15 @@ namespace rosin::engine {
 
 enum class StringPolicy { LowestPosition = 0, StayOnString = 1, FixedString = 2 };
 
+/// A bow played from outside MIDI (a HID controller): while active it replaces the nominal
+/// force, speed and position and the controller scaling; speed is signed (its sign is the bow
+/// direction, so a sign change is a bow change).
+struct ExternalBow {
+    bool active = false, engaged = false;
+    float force = 0.0f, speed = 0.0f, beta = 0.1f; ///< N, m/s, fraction of the string
+    int string = -1;                               ///< string new notes prefer, -1 none
+};
+
 /// What a test or an editor may want to know about a voice.
 struct VoiceInfo {
     bool active = false;
@@ -50,6 +59,10 @@ public:
     void handleMidi(const std::uint8_t* data, int size) noexcept;
     /// [audio thread] Writes numSamples to both outputs (any length: mixed in chunks).
     void render(float* left, float* right, int numSamples) noexcept;
+
+    /// [audio thread] The controller's bow (applied at the next control tick of every voice).
+    void setExternalBow(const ExternalBow& bow) noexcept;
+    const ExternalBow& externalBow() const noexcept { return external_; }
 
     void releaseAll() noexcept; ///< bow lift on every voice (all notes off)
     void killAll() noexcept;    ///< silence now (all sound off)
@@ -136,6 +149,7 @@ private:
     double ringCoefficient_ = 0.999;
     dsp::FrictionModel appliedModel_ = dsp::FrictionModel::Thermal;
     int tag_ = -1;
+    ExternalBow external_;
 };
 
 } // namespace rosin::engine
