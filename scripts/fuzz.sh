@@ -12,7 +12,7 @@ clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-reco
   -I "$src/include" -I plugin/engine/include \
   "$src/fuzz/FuzzHid.cpp" "$src/src/Descriptor.cpp" "$src/src/Mapping.cpp" -o "$out/fuzz-hid"
 # Seeds: every real descriptor, wrapped in the input format with one all-zero report.
-for f in ../shared/data/hid/*.rdesc.bin; do
+for f in tests/data/hid/*.rdesc.bin; do
   [[ -f "$f" ]] || continue
   n=$(stat -c %s "$f")
   { printf "\\x$(printf %02x $((n & 255)))\\x$(printf %02x $((n >> 8)))"; cat "$f"; printf '\x08\x01\x00\x00\x00\x00\x00\x00\x00'; } \

@@ -17,6 +17,8 @@ CORE_PKGS=(
   lilv-utils                               # lv2ls / lv2info see the built LV2
   ardour                                   # ardour7-lua: a real DAW loads VST3 and LV2 headless
   xvfb xauth                               # the Standalone needs an X display
+  libhidapi-dev libusb-1.0-0-dev           # HID controllers (pen tablets, gamepads, 3D mice)
+  clang libclang-rt-14-dev                 # libFuzzer for the HID parser fuzz run
 )
 
 missing=()

@@ -30,6 +30,16 @@ RosinEditor::RosinEditor(plugin::RosinProcessor& processor)
             status_.setText(e.what(), juce::dontSendNotification);
         }
     };
+    id = 1;
+    controller_.setTextWhenNothingSelected("HID controller map...");
+    for (const auto& name : engine::listPresets(dir, "controllers")) controller_.addItem(name, id++);
+    controller_.onChange = [this] {
+        try {
+            processor_.loadHidMapping(controller_.getText());
+        } catch (const std::exception& e) {
+            status_.setText(e.what(), juce::dontSendNotification);
+        }
+    };
     learn_.setTextWhenNothingSelected("MIDI learn: pick a parameter, move a controller");
     for (int i = 0; i < engine::paramCount; ++i) {
         const auto& info = engine::paramInfo(i);
@@ -39,7 +49,7 @@ RosinEditor::RosinEditor(plugin::RosinProcessor& processor)
         if (learn_.getSelectedId() > 0) processor_.controllerMap().armLearn(learn_.getSelectedId() - 1);
     };
     clearMappings_.onClick = [this] { processor_.controllerMap().assign({}); };
-    for (auto* c : std::initializer_list<juce::Component*>{&exciter_, &mapping_, &learn_, &clearMappings_, &status_})
+    for (auto* c : std::initializer_list<juce::Component*>{&exciter_, &mapping_, &controller_, &learn_, &clearMappings_, &status_})
         addAndMakeVisible(c);
     setResizable(true, true);
     setSize(640, 720);
@@ -52,8 +62,10 @@ void RosinEditor::resized()
 {
     auto area = getLocalBounds().reduced(6);
     auto row = area.removeFromTop(28);
-    exciter_.setBounds(row.removeFromLeft(row.getWidth() / 2).reduced(2));
-    mapping_.setBounds(row.reduced(2));
+    const int third = row.getWidth() / 3;
+    exciter_.setBounds(row.removeFromLeft(third).reduced(2));
+    mapping_.setBounds(row.removeFromLeft(third).reduced(2));
+    controller_.setBounds(row.reduced(2));
     row = area.removeFromTop(28);
     clearMappings_.setBounds(row.removeFromRight(130).reduced(2));
     learn_.setBounds(row.reduced(2));
@@ -70,7 +82,8 @@ void RosinEditor::timerCallback()
 
 void RosinEditor::refreshMappings()
 {
-    juce::String text = processor_.currentInstrument() + ", " + juce::String(processor_.activeVoices()) + " voices. Learned: ";
+    juce::String text = processor_.currentInstrument() + ", " + juce::String(processor_.activeVoices()) + " voices. HID: " +
+                        juce::String(processor_.hidInput().status()) + ". Learned: ";
     const auto entries = processor_.controllerMap().entries();
     if (entries.empty()) text << "none";
     for (const auto& e : entries) {

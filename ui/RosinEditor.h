@@ -20,7 +20,7 @@ private:
 
     plugin::RosinProcessor& processor_;
     juce::GenericAudioProcessorEditor generic_;
-    juce::ComboBox exciter_, mapping_, learn_;
+    juce::ComboBox exciter_, mapping_, controller_, learn_;
     juce::TextButton clearMappings_{"Clear mappings"};
     juce::Label status_;
     juce::String lastMappings_;

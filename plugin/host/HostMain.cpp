@@ -12,6 +12,10 @@
 
 #include "AuditCounter.h"
 #include "PluginHost.h"
+#include "rosin/hid/HidInput.h"
+
+#include <chrono>
+#include <thread>
 
 using namespace rosin::host;
 namespace fs = std::filesystem;
@@ -102,7 +106,51 @@ int main(int argc, char** argv)
     auto* params = app.add_subcommand("params", "list the plugin's parameters (ID, name, value)");
     params->add_option("--plugin", plugin, "the built plugin bundle (.vst3 or .lv2)")->required();
 
+    auto* hidCmd = app.add_subcommand("hid", "list HID devices and whether Rosin can play them; --seconds S also prints "
+                                             "the bow the first controller plays (no plugin needed)");
+    double hidSeconds = 0.0;
+    hidCmd->add_option("--seconds", hidSeconds, "watch the controller this long")->check(CLI::Range(0.0, 3600.0));
+
     CLI11_PARSE(app, argc, argv);
+    if (hidCmd->parsed()) {
+        using namespace rosin::hid;
+        auto backend = makeHidapiBackend();
+        const auto devices = backend->enumerate();
+        if (devices.empty()) std::printf("no HID devices (hidraw) found\n");
+        int playable = 0;
+        for (const auto& d : devices) {
+            std::string error, verdict;
+            auto h = backend->open(d, error);
+            if (!h) {
+                verdict = "cannot open: " + error;
+            } else {
+                try {
+                    const DeviceDecoder dec(parseDescriptor(h->descriptor()), quirksFor(d.vendor, d.product));
+                    verdict = kindName(dec.kind());
+                    playable += dec.kind() != DeviceKind::Other ? 1 : 0;
+                } catch (const std::exception& e) {
+                    verdict = std::string("descriptor: ") + e.what();
+                }
+            }
+            std::printf("%04x:%04x  %-14s %-40s %s\n", d.vendor, d.product, d.path.c_str(), d.name.c_str(), verdict.c_str());
+        }
+        if (hidSeconds > 0.0) {
+            HidInput input(std::move(backend));
+            input.start();
+            const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(hidSeconds);
+            BowCommand c, last;
+            while (std::chrono::steady_clock::now() < end) {
+                bool got = false;
+                while (input.queue().pop(c)) { last = c; got = true; }
+                if (got)
+                    std::printf("%-40s force %5.2f N  speed %+6.3f m/s  beta %.3f  string %d%s\n", input.status().c_str(), last.force,
+                                last.speed, last.beta, last.string, last.bowChange ? "  bow change" : "");
+                std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            }
+            std::printf("%s; %llu reports\n", input.status().c_str(), static_cast<unsigned long long>(input.reportsRead()));
+        }
+        return 0;
+    }
     try {
         PluginHost host(plugin);
         if (bench->parsed()) {

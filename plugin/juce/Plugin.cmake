@@ -32,7 +32,7 @@ target_compile_definitions(RosinPlugin PUBLIC ${ROSIN_JUCE_DEFINITIONS}
   JUCE_VST3_CAN_REPLACE_VST2=0
   ROSIN_SOURCE_PRESET_DIR="${PROJECT_SOURCE_DIR}/presets")
 target_link_libraries(RosinPlugin
-  PRIVATE rosin::engine juce::juce_audio_utils juce::juce_audio_plugin_client ${CMAKE_DL_LIBS}
+  PRIVATE rosin::engine rosin::hid juce::juce_audio_utils juce::juce_audio_plugin_client ${CMAKE_DL_LIBS}
   PUBLIC juce::juce_recommended_config_flags juce::juce_recommended_warning_flags)
 
 # Presets travel inside each bundle, so an installed plugin finds them without the source tree.
@@ -66,7 +66,7 @@ target_compile_features(rosin_host_core PUBLIC cxx_std_20)
 # The audit counter interposes malloc/pthread_mutex_lock: executables export it (-rdynamic)
 # so the dlopen'ed plugin binds to it.
 add_executable(rosin-host ${CMAKE_CURRENT_SOURCE_DIR}/host/HostMain.cpp ${CMAKE_CURRENT_SOURCE_DIR}/host/AuditCounter.cpp)
-target_link_libraries(rosin-host PRIVATE rosin_host_core CLI11::CLI11 nlohmann_json::nlohmann_json ${CMAKE_DL_LIBS})
+target_link_libraries(rosin-host PRIVATE rosin_host_core rosin::hid CLI11::CLI11 nlohmann_json::nlohmann_json ${CMAKE_DL_LIBS})
 set_target_properties(rosin-host PROPERTIES ENABLE_EXPORTS ON)
 add_dependencies(rosin-host RosinPlugin_VST3 RosinPlugin_LV2)
 

@@ -69,6 +69,7 @@ public:
         while (!threadShouldExit()) {
             wait(20); // polls: the audio thread never signals (signalling takes a lock)
             owner_.collectGarbage();
+            owner_.pollHid();
             const double rate = owner_.sampleRate_.load();
             const int wanted = juce::roundToInt(owner_.instrumentRaw_->load());
             if (rate > 0.0 && wanted != owner_.loadedInstrument_.load()) {
@@ -109,6 +110,8 @@ juce::AudioProcessorValueTreeState::ParameterLayout RosinProcessor::createLayout
     }
     layout.add(std::make_unique<juce::AudioParameterChoice>(juce::ParameterID{instrumentParamId, 1}, "Instrument",
                                                              instrumentNames(), 2));
+    layout.add(std::make_unique<juce::AudioParameterChoice>(juce::ParameterID{hidParamId, 1}, "HID controller",
+                                                             juce::StringArray{"Off", "On"}, 0));
     return layout;
 }
 
@@ -122,6 +125,8 @@ RosinProcessor::RosinProcessor()
         jassert(raw_[static_cast<std::size_t>(i)] != nullptr);
     }
     instrumentRaw_ = state_.getRawParameterValue(instrumentParamId);
+    hidRaw_ = state_.getRawParameterValue(hidParamId);
+    hid_ = std::make_unique<hid::HidInput>(hid::makeHidapiBackend());
     pushed_.fill(std::numeric_limits<float>::quiet_NaN());
     presetDir_ = findPresetDirectory();
     loadedInstrument_.store(juce::roundToInt(instrumentRaw_->load()));
@@ -132,6 +137,7 @@ RosinProcessor::RosinProcessor()
 RosinProcessor::~RosinProcessor()
 {
     loader_->stopThread(2000);
+    hid_->stop();
     collectGarbage();
     delete pending_.exchange(nullptr);
     delete retiring_;
@@ -163,6 +169,47 @@ void RosinProcessor::collectGarbage()
 {
     engine::Synth* old = nullptr;
     while (trash_.pop(old)) delete old;
+}
+
+void RosinProcessor::pollHid()
+{
+    const bool wanted = hidRaw_->load() > 0.5f;
+    if (wanted && !hid_->running()) hid_->start();
+    if (!wanted && hid_->running()) hid_->stop();
+}
+
+void RosinProcessor::loadHidMapping(const juce::String& name)
+{
+    juce::File file(name);
+    if (!name.endsWith(".json")) file = presetDir_.getChildFile("controllers").getChildFile(name + ".json");
+    if (!file.existsAsFile()) throw std::runtime_error(file.getFullPathName().toStdString() + ": no such controller map");
+    hid_->setMapping(hid::HidMapping::fromJson(file.loadFileAsString().toStdString(), file.getFullPathName().toStdString()));
+}
+
+void RosinProcessor::drainHid(engine::Synth& synth) noexcept
+{
+    // Every note trigger counts; for the bow only the latest state matters.
+    hid::BowCommand c;
+    bool got = false;
+    while (hid_->queue().pop(c)) {
+        got = true;
+        for (int off : {static_cast<int>(c.noteOff), static_cast<int>(c.noteOff2)})
+            if (off >= 0) {
+                const std::uint8_t msg[3] = {0x80, static_cast<std::uint8_t>(off), 0};
+                synth.handleMidi(msg, 3);
+            }
+        for (int on : {static_cast<int>(c.noteOn), static_cast<int>(c.noteOn2)})
+            if (on >= 0) {
+                const std::uint8_t msg[3] = {0x90, static_cast<std::uint8_t>(on), 100};
+                synth.handleMidi(msg, 3);
+            }
+        external_ = {true, c.engaged, c.force, c.speed, c.beta, c.string};
+    }
+    if (!hid_->running() && external_.active) { // switched off: the parameters play again
+        external_ = {};
+        got = true;
+    }
+    if (got) synth.setExternalBow(external_);
 }
 
 void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults)
@@ -317,6 +364,7 @@ void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBu
                 retiringLeft_ = fadeSamples;
             }
             current_ = next;
+            current_->setExternalBow(external_);
             installedInstrument_ = next->tag();
             pushed_.fill(std::numeric_limits<float>::quiet_NaN());
         }
@@ -325,6 +373,7 @@ void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBu
     if (current_ == nullptr || buffer.getNumChannels() < 2) {
         buffer.clear();
     } else {
+        drainHid(*current_);
         renderSynth(*current_, buffer, &midi, true);
         activeVoices_.store(current_->activeVoiceCount(), std::memory_order_relaxed);
     }
@@ -364,6 +413,9 @@ void RosinProcessor::getStateInformation(juce::MemoryBlock& destData)
         m->setAttribute("max", static_cast<double>(e.max));
         m->setAttribute("invert", e.invert);
     }
+    auto* hidXml = xml->createNewChildElement("Hid");
+    for (auto kind : {hid::DeviceKind::Tablet, hid::DeviceKind::Gamepad, hid::DeviceKind::SpaceMouse, hid::DeviceKind::Joystick})
+        hidXml->createNewChildElement("Mapping")->addTextElement(hid_->mapping(kind).toJson());
     copyXmlToBinary(*xml, destData);
 }
 
@@ -383,6 +435,16 @@ void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
             if (e.cc >= 0 && e.cc < engine::ControllerMap::numControllers && e.param >= 0) entries.push_back(e);
         }
         xml->removeChildElement(maps, true);
+    }
+    if (auto* hidXml = xml->getChildByName("Hid")) {
+        for (auto* m : hidXml->getChildIterator()) {
+            try {
+                hid_->setMapping(hid::HidMapping::fromJson(m->getAllSubText().toStdString(), "saved state"));
+            } catch (const std::exception& e) {
+                DBG("Rosin: " << e.what()); // keep the default map for that device
+            }
+        }
+        xml->removeChildElement(hidXml, true);
     }
     xml->removeAttribute("format");
     state_.replaceState(juce::ValueTree::fromXml(*xml));

@@ -17,12 +17,14 @@
 #include "rosin/engine/SpscQueue.h"
 #include "rosin/engine/ControllerMap.h"
 #include "rosin/engine/Synth.h"
+#include "rosin/hid/HidInput.h"
 
 namespace rosin::plugin {
 
 class RosinProcessor : public juce::AudioProcessor {
 public:
     static constexpr const char* instrumentParamId = "instrument";
+    static constexpr const char* hidParamId = "hid_input";
     static const juce::StringArray& instrumentNames();
 
     RosinProcessor();
@@ -58,6 +60,11 @@ public:
     void loadExciter(const juce::String& name);
     void loadMapping(const juce::String& name);
 
+    /// [any thread but audio] A controller map from presets/controllers (rosin-hid/1).
+    void loadHidMapping(const juce::String& name);
+    /// The HID controller input (its thread starts when the hid_input parameter is on).
+    hid::HidInput& hidInput() noexcept { return *hid_; }
+
     juce::AudioProcessorValueTreeState& parameters() noexcept { return state_; }
     engine::ControllerMap& controllerMap() noexcept { return map_; }
     juce::String currentInstrument() const;
@@ -69,6 +76,8 @@ private:
     std::unique_ptr<engine::Synth> buildSynth(const juce::String& instrument, double sampleRate) const;
     void handOver(std::unique_ptr<engine::Synth> synth);
     void collectGarbage();
+    void pollHid(); ///< [loader thread] start or stop the HID input with its parameter
+    void drainHid(engine::Synth& synth) noexcept;
     engine::ParamValues currentParams() const;
     void renderSynth(engine::Synth& synth, juce::AudioBuffer<float>& buffer, const juce::MidiBuffer* midi,
                      bool pushParams) noexcept;
@@ -78,6 +87,9 @@ private:
     std::array<std::atomic<float>*, engine::paramCount> raw_{};
     std::array<float, engine::paramCount> pushed_{};
     std::atomic<float>* instrumentRaw_ = nullptr;
+    std::atomic<float>* hidRaw_ = nullptr;
+    std::unique_ptr<hid::HidInput> hid_;
+    engine::ExternalBow external_; ///< [audio thread] the controller's bow, re-applied after an engine swap
 
     // Audio-thread owned.
     engine::Synth* current_ = nullptr;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 
 #include "rosin/hid/Descriptor.h"
 #include "rosin/hid/Mapping.h"
@@ -205,4 +206,16 @@ TEST(HidMapping, ReleaseEndsHeldNotes)
     EXPECT_FALSE(r.engaged);
     EXPECT_EQ(r.noteOff, 50);
     EXPECT_EQ(r.force, 0.0f);
+}
+
+TEST(HidMapping, ShippedControllerMapsLoad)
+{
+    for (const std::string kind : {"tablet", "gamepad", "spacemouse", "joystick"}) {
+        std::ifstream in(fs::path(ROSIN_PRESETS) / "controllers" / (kind + ".json"));
+        ASSERT_TRUE(in) << kind;
+        const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        const HidMapping m = HidMapping::fromJson(text, kind);
+        EXPECT_EQ(kindName(m.kind), kind);
+        EXPECT_NE(m.force, Source::None) << kind;
+    }
 }

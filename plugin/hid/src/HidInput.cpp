@@ -42,6 +42,13 @@ void HidInput::setFilter(std::uint16_t vendor, std::uint16_t product)
     filterProduct_ = product;
 }
 
+bool HidInput::setBackend(std::unique_ptr<DeviceBackend> backend)
+{
+    if (running_.load() || !backend) return false;
+    backend_ = std::move(backend);
+    return true;
+}
+
 void HidInput::start()
 {
     if (running_.exchange(true)) return;
@@ -85,7 +92,7 @@ void HidInput::run()
 {
     setStatus("no controller");
     std::vector<std::uint8_t> buffer(4096);
-    std::string lastError;
+    std::string lastError, gone;
     while (!stopRequested_) {
         // Find a device we can play.
         std::unique_ptr<DeviceHandle> handle;
@@ -119,13 +126,14 @@ void HidInput::run()
             break;
         }
         if (!handle) {
-            setStatus(lastError.empty() ? "no controller" : lastError);
+            setStatus(!lastError.empty() ? lastError : gone.empty() ? "no controller" : gone + " unplugged, waiting for a controller");
             const double until = now() + rescanSeconds;
             while (!stopRequested_ && now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(20));
             continue;
         }
         ++connections_;
         lastError.clear();
+        gone.clear();
         BowMapper mapper(mapping(decoder.kind()));
         DeviceState state;
         setStatus(info.name + " (" + kindName(decoder.kind()) + ")");
@@ -133,6 +141,7 @@ void HidInput::run()
             const int n = handle->read(buffer.data(), buffer.size(), 10);
             if (n < 0) { // unplugged mid-note: lift the bow and end its notes
                 push(mapper.release(now()));
+                gone = info.name;
                 setStatus(info.name + " unplugged");
                 break;
             }

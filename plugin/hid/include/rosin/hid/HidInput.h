@@ -55,6 +55,9 @@ public:
     /// Only devices with this vendor:product (0 = any recognised controller).
     void setFilter(std::uint16_t vendor, std::uint16_t product);
 
+    /// Replace the device layer (tests: a fake device). Only while stopped; ignored otherwise.
+    bool setBackend(std::unique_ptr<DeviceBackend> backend);
+
     void start();
     void stop();
     bool running() const { return running_.load(); }
