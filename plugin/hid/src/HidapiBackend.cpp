@@ -1,6 +1,10 @@
 // hidapi's hidraw backend: enumerate, open by path, read with a timeout. The descriptor is read
 // from sysfs, which needs no extra permission beyond the node itself.
+#include <fcntl.h>
 #include <hidapi/hidapi.h>
+#include <linux/hidraw.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -35,7 +39,19 @@ public:
         // /dev/hidraw3 -> /sys/class/hidraw/hidraw3/device/report_descriptor
         const std::filesystem::path node(path_);
         std::ifstream in("/sys/class/hidraw/" + node.filename().string() + "/device/report_descriptor", std::ios::binary);
-        return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        if (!bytes.empty()) return bytes;
+        // No sysfs (some containers): ask the node itself.
+        const int fd = ::open(path_.c_str(), O_RDONLY | O_NONBLOCK);
+        if (fd < 0) return {};
+        int size = 0;
+        hidraw_report_descriptor desc{};
+        if (ioctl(fd, HIDIOCGRDESCSIZE, &size) == 0 && size > 0 && size <= HID_MAX_DESCRIPTOR_SIZE) {
+            desc.size = static_cast<__u32>(size);
+            if (ioctl(fd, HIDIOCGRDESC, &desc) == 0) bytes.assign(desc.value, desc.value + size);
+        }
+        ::close(fd);
+        return bytes;
     }
 
 private:
