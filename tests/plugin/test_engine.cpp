@@ -75,7 +75,7 @@ TEST(EnginePresets, EveryInstrumentLoadsWithItsFourStringsInPitchOrder)
         EXPECT_GE(p.body.count, 8) << name;
         EXPECT_TRUE(p.strings[0].validate().empty()) << name;
     }
-    EXPECT_NEAR(loadInstrument(presetDir, "double-bass").rosinTg, 16.0, 1e-9);
+    EXPECT_NEAR(loadInstrument(presetDir, "double-bass").bowPosition, 0.13, 1e-9);
     EXPECT_EQ(listPresets(presetDir, "instruments").size(), 4u);
     EXPECT_EQ(loadExciter(presetDir, "enhanced-rod").contact, dsp::ContactLaw::PowerLaw);
     const MappingPreset keyboard = loadMapping(presetDir, "keyboard");

@@ -75,8 +75,8 @@ TEST(Processor, LoadingAnInstrumentPresetSetsItsBowDefaults)
     p.setPlayConfigDetails(0, 2, 48000.0, 256);
     p.prepareToPlay(48000.0, 256);
     p.loadInstrument("double-bass", true);
-    EXPECT_FLOAT_EQ(p.parameters().getRawParameterValue("bow_force")->load(), 1.5f);
-    EXPECT_FLOAT_EQ(p.parameters().getRawParameterValue("rosin_tg")->load(), 16.0f);
+    EXPECT_FLOAT_EQ(p.parameters().getRawParameterValue("bow_force")->load(), 3.0f);
+    EXPECT_FLOAT_EQ(p.parameters().getRawParameterValue("bow_position")->load(), 0.13f);
     EXPECT_EQ(p.currentInstrument(), "double-bass");
     play(p, {juce::MidiMessage::noteOn(1, 40, 0.8f)}, 8);
     EXPECT_EQ(p.activeVoices(), 1);

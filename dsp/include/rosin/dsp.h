@@ -1,6 +1,7 @@
 // Umbrella header of the real-time model library.
 #pragma once
 #include "rosin/dsp/Body.h"
+#include "rosin/dsp/BowGesture.h"
 #include "rosin/dsp/BowJunction.h"
 #include "rosin/dsp/BowedString.h"
 #include "rosin/dsp/Config.h"

@@ -9,16 +9,16 @@ namespace {
 // diagrams in Euphonics ch. 9 span about 0.01-5 N and 0.01-1 m/s); beta 0.02-0.3 spans sul
 // ponticello to sul tasto. Temperatures cover rooms and rosins (violin Tg 49 C, bass 16 C).
 constexpr std::array<ParamInfo, paramCount> table{{
-    {"bow_force", "Bow force", "N", 0.0f, 5.0f, 0.6f, 0.8f, 0, ""},
+    {"bow_force", "Bow force", "N", 0.0f, 5.0f, 1.1f, 0.8f, 0, ""},
     {"bow_speed", "Bow speed", "m/s", 0.0f, 1.0f, 0.15f, 0.2f, 0, ""},
-    {"bow_position", "Bow position (beta)", "", 0.02f, 0.3f, 0.1f, 0.1f, 0, ""},
+    {"bow_position", "Bow position (beta)", "", 0.02f, 0.3f, 0.0899f, 0.1f, 0, ""},
     {"friction_model", "Friction model", "", 0.0f, 2.0f, 1.0f, 1.0f, 3, "Friction curve|Thermal|Enhanced thermal"},
     {"contact_law", "Contact law", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Amontons|Hertz"},
     {"rosin_tg", "Rosin glass transition", "C", 0.0f, 80.0f, 49.0f, 40.0f, 0, ""},
     {"ambient", "Ambient temperature", "C", 0.0f, 40.0f, 20.0f, 20.0f, 0, ""},
     {"footprint_ratio", "Footprint ratio r_A", "", 0.25f, 2.0f, 1.0f, 1.0f, 0, ""},
-    {"attack_accel", "Attack acceleration", "m/s^2", 0.1f, 30.0f, 6.0f, 4.0f, 0, ""},
-    {"attack_force", "Attack force boost", "", 0.0f, 2.0f, 0.5f, 0.5f, 0, ""},
+    {"attack_accel", "Attack acceleration", "m/s^2", 0.1f, 30.0f, 1.27f, 4.0f, 0, ""},
+    {"attack_force", "Attack force boost", "", 0.0f, 2.0f, 0.0f, 0.5f, 0, ""},
     {"release_time", "Bow lift time", "s", 0.005f, 2.0f, 0.08f, 0.2f, 0, ""},
     {"portamento", "Portamento", "s", 0.0f, 1.0f, 0.06f, 0.1f, 0, ""},
     {"legato", "Legato", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Off|On"},
@@ -32,6 +32,14 @@ constexpr std::array<ParamInfo, paramCount> table{{
     {"gain", "Output gain", "dB", -60.0f, 12.0f, 0.0f, -12.0f, 0, ""},
     {"mpe", "MPE", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Off|On"},
     {"intonation", "Intonation by ear", "", 0.0f, 1.0f, 1.0f, 0.5f, 0, ""},
+    {"articulation", "Articulation", "", 0.0f, 5.0f, 0.0f, 2.5f, 6, "Detache|Martele|Spiccato|Tremolo|Col legno|Pizzicato"},
+    {"tremolo_rate", "Tremolo rate", "strokes/s", 2.0f, 20.0f, 8.0f, 8.0f, 0, ""},
+    {"spiccato_rate", "Spiccato rate", "bounces/s", 2.0f, 15.0f, 7.0f, 7.0f, 0, ""},
+    {"bow_length", "Bow length", "m", 0.2f, 0.75f, 0.65f, 0.5f, 0, ""},
+    {"vibrato_auto", "Automatic vibrato", "", 0.0f, 1.0f, 0.0f, 0.5f, 0, ""},
+    {"vibrato_delay", "Vibrato onset delay", "s", 0.0f, 2.0f, 0.3f, 0.5f, 0, ""},
+    {"mute", "Mute (sordino)", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Off|On"},
+    {"articulation_channels", "Articulation per MIDI channel", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Off|On"},
 }};
 } // namespace
 

@@ -129,6 +129,7 @@ InstrumentPreset loadInstrument(const fs::path& presetDir, const std::string& na
         p.bowSpeed = r.number(b, "speed_m_s", "bow: ", false, p.bowSpeed, 0.0, 1.0);
         p.bowPosition = r.number(b, "position", "bow: ", false, p.bowPosition, 0.02, 0.3);
         p.attackAccel = r.number(b, "attack_accel_m_s2", "bow: ", false, p.attackAccel, 0.1, 30.0);
+        if (b.contains("note") && !b["note"].is_string()) r.fail("bow: field 'note' must be text");
     }
     if (j.contains("rosin")) {
         try {

@@ -12,7 +12,6 @@ namespace rosin::engine {
 namespace {
 constexpr double controlSmoothingSeconds = 0.01; ///< force/speed/gain one-pole time constant
 constexpr double betaSmoothingSeconds = 0.02;    ///< at control rate: beta redesigns the loss filters
-constexpr double boostSeconds = 0.08;            ///< the attack's extra force decays over this
 constexpr double ringSeconds = 0.6;              ///< 60 dB decay of a string after the bow lifts
 constexpr double silence = 1e-5;                 ///< -100 dB: the voice is free
 constexpr int memberBendRange = 48, masterBendRange = 2; ///< MPE defaults (M1-100-UM)
@@ -57,7 +56,14 @@ void Synth::prepare(double sampleRate, const InstrumentPreset& instrument, const
     for (auto& v : voices_)
         for (int s = 0; s < instrument.stringCount; ++s) v.strings[static_cast<std::size_t>(s)] = templates[static_cast<std::size_t>(s)];
 
+    // The nominal force is the third string's; a player leans harder on thicker strings, and
+    // Schelleng's force limits scale with the string's impedance, so the others scale with Z0.
+    const double zRef = instrument.strings[static_cast<std::size_t>(std::min(2, std::max(0, instrument.stringCount - 1)))].impedance();
+    for (int s = 0; s < maxStrings; ++s)
+        forceScale_[static_cast<std::size_t>(s)] = s < instrument.stringCount ? instrument.strings[static_cast<std::size_t>(s)].impedance() / zRef : 1.0;
+    for (auto& v : voices_) v.gesture.prepare(sampleRate);
     for (auto& b : body_) b.prepare(sampleRate, instrument.body);
+    applyBody();
     busL_.assign(chunk, 0.0f);
     busR_.assign(chunk, 0.0f);
     smoothing_ = onePole(controlSmoothingSeconds, sampleRate);
@@ -74,6 +80,8 @@ void Synth::reset() noexcept
     }
     channels_ = {};
     lastString_.fill(-1);
+    nextDirection_.fill(1);
+    bowPosition_.fill(0.1);
     mcmLower_ = mcmUpper_ = -1;
     for (auto& b : body_) b.reset();
     gainTarget_ = gain_ = dbToGain(params_[static_cast<int>(Param::Gain)]);
@@ -96,6 +104,7 @@ void Synth::setParameter(int index, float value) noexcept
     case Param::Ambient:
     case Param::Footprint: applyFriction(); break;
     case Param::Gain: gainTarget_ = dbToGain(value); break;
+    case Param::Mute: applyBody(); break;
     default: break;
     }
 }
@@ -267,6 +276,10 @@ void Synth::controller(int ch, int cc, float value) noexcept
     case 4:
     case 74: c.position = value; break;
     case 7: c.volume = value; break;
+    case 20: // articulation by controller: the range split evenly
+        setParameter(static_cast<int>(Param::Articulation),
+                     std::min(static_cast<float>(dsp::Articulation::Count) - 1.0f, std::floor(value * static_cast<float>(dsp::Articulation::Count))));
+        break;
     case 11: c.expression = value; break;
     case 64: {
         const bool on = value >= 0.5f;
@@ -318,6 +331,10 @@ Synth::Voice* Synth::findVoiceToStart() noexcept
 
 void Synth::noteOn(int ch, int note, int velocity) noexcept
 {
+    if (note >= keyswitchBase && note < keyswitchBase + static_cast<int>(dsp::Articulation::Count)) {
+        setParameter(static_cast<int>(Param::Articulation), static_cast<float>(note - keyswitchBase)); // a keyswitch, not a note
+        return;
+    }
     const double f = noteFrequency(note);
     const bool legato = params_[static_cast<int>(Param::Legato)] > 0.5f;
     if (legato) {
@@ -367,15 +384,37 @@ void Synth::startVoice(Voice& v, int ch, int note, int velocity, int s) noexcept
     v.pitch = v.glideTarget = note;
     v.glideStep = 0.0;
     // Velocity is the attack: Guettler's constant bow acceleration from rest, and a force that
-    // starts above the nominal and settles (a player "bites" harder for a louder attack).
-    v.accel = params_[static_cast<int>(Param::AttackAccel)] * std::max(0.05, static_cast<double>(v.velocity));
-    v.boost = params_[static_cast<int>(Param::AttackForce)] * v.velocity;
+    // starts above the nominal and settles (a player "bites" harder for a louder attack). The
+    // articulation shapes the stroke; consecutive notes on a channel alternate down and up bow
+    // and continue from where on the bow the last one ended.
+    dsp::GestureSettings gs;
+    gs.bowLength = params_[static_cast<int>(Param::BowLength)];
+    gs.acceleration = params_[static_cast<int>(Param::AttackAccel)];
+    gs.attackBoost = params_[static_cast<int>(Param::AttackForce)];
+    gs.releaseTime = params_[static_cast<int>(Param::ReleaseTime)];
+    gs.tremoloRate = params_[static_cast<int>(Param::TremoloRate)];
+    gs.spiccatoRate = params_[static_cast<int>(Param::SpiccatoRate)];
+    const bool byChannel = params_[static_cast<int>(Param::ArticulationChannels)] > 0.5f;
+    const int articulation = byChannel && ch < static_cast<int>(dsp::Articulation::Count)
+                                 ? ch
+                                 : static_cast<int>(params_[static_cast<int>(Param::Articulation)]);
+    const auto cs = static_cast<std::size_t>(ch);
+    const int direction = nextDirection_[cs] >= 0 ? 1 : -1;
+    v.gesture.start(static_cast<dsp::Articulation>(articulation), v.velocity, gs, direction,
+                    std::clamp(bowPosition_[cs], 0.0, gs.bowLength));
+    nextDirection_[cs] = -direction;
     v.speed = 0.0;
     v.force = 0.0;
+    v.aimForce = 0.0;
     v.lift = 1.0;
     v.fade = 1.0;
+    v.age = 0.0;
     v.peak = 0.0;
-    v.quietSamples = 0.0;
+    if (tapArmed_) {
+        tapArmed_ = false;
+        tapVoice_ = &v;
+        tapCount_ = 0;
+    }
     v.vibratoPhase = 0.0;
     v.wasStick = true;
     v.samplesSinceSlip = v.periodsHeard = 0;
@@ -421,6 +460,32 @@ void Synth::releaseVoice(Voice& v) noexcept
     v.keyDown = false;
     v.sustained = false;
     v.released = true;
+    v.gesture.release();
+    bowPosition_[static_cast<std::size_t>(v.channel)] = v.gesture.bowPosition();
+}
+
+void Synth::setVoiceTap(float* bridgeForce, std::uint8_t* stick, int capacity) noexcept
+{
+    tapBridge_ = bridgeForce;
+    tapStick_ = stick;
+    tapCapacity_ = bridgeForce ? capacity : 0;
+    tapCount_ = 0;
+    tapVoice_ = nullptr;
+    tapArmed_ = bridgeForce != nullptr;
+}
+
+void Synth::applyBody() noexcept
+{
+    // A mute is a mass clamped on the bridge: the bridge hill and the upper body modes move down
+    // and lose most of their output (Euphonics ch. 10's account of the mute; the factors are [A]).
+    dsp::BodyParams b = instrument_.body;
+    if (params_[static_cast<int>(Param::Mute)] > 0.5f)
+        for (int i = 0; i < b.count; ++i) {
+            auto& m = b.modes[static_cast<std::size_t>(i)];
+            m.frequency *= m.frequency > 600.0 ? 0.8 : 0.95;
+            if (m.frequency > 800.0) m.gain *= 0.3;
+        }
+    for (auto& body : body_) body.retune(fs_, b);
 }
 
 void Synth::setExternalBow(const ExternalBow& bow) noexcept
@@ -466,7 +531,7 @@ void Synth::updateControl(Voice& v) noexcept
     const double speedScale = expression < 0.0f ? 1.0 : 2.0 * expression;
     const double betaScale = position < 0.0f ? 1.0 : std::exp2(2.0 * (position - 0.5));
     if (!external_.active) {
-        v.targetForce = params_[static_cast<int>(Param::BowForce)] * forceScale;
+        v.targetForce = params_[static_cast<int>(Param::BowForce)] * forceScale * forceScale_[static_cast<std::size_t>(v.stringIndex)];
         v.targetSpeed = params_[static_cast<int>(Param::BowSpeed)] * speedScale;
         const double betaTarget = std::clamp(params_[static_cast<int>(Param::BowPosition)] * betaScale, 0.02, 0.3);
         v.beta += (betaTarget - v.beta) * betaSmoothing_;
@@ -480,7 +545,10 @@ void Synth::updateControl(Voice& v) noexcept
     }
     double bend = c.bend * bendRangeOf(v.channel);
     if (m) bend += m->bend * bendRangeOf(master);
-    const double vibratoAmount = std::max(c.vibrato, m ? m->vibrato : 0.0f);
+    v.age += controlInterval / fs_;
+    const double onset = std::clamp((v.age - params_[static_cast<int>(Param::VibratoDelay)]) / 0.3, 0.0, 1.0);
+    const double vibratoAmount = std::max({static_cast<double>(c.vibrato), m ? static_cast<double>(m->vibrato) : 0.0,
+                                           params_[static_cast<int>(Param::VibratoAuto)] * onset});
     double vibrato = 0.0;
     if (vibratoAmount > 0.0) {
         vibrato = params_[static_cast<int>(Param::VibratoDepth)] / 100.0 * vibratoAmount * std::sin(v.vibratoPhase);
@@ -491,6 +559,7 @@ void Synth::updateControl(Voice& v) noexcept
     }
     v.targetPeriod = fs_ / noteFrequency(v.pitch + bend);
     const double intonation = params_[static_cast<int>(Param::Intonation)];
+    if (v.gesture.plucked()) v.beta = 0.25; // plucked over the end of the fingerboard, struck likewise
     v.frequency = noteFrequency(v.pitch + bend + vibrato + intonation * v.correctionCents / 100.0);
     // Re-stopping redesigns the loss filters: skip moves below 0.02 cent (the ear's correction
     // creeps by less than that between periods once it has settled).
@@ -503,38 +572,57 @@ void Synth::renderVoice(Voice& v, float* busL, float* busR, int n) noexcept
     auto& string = v.strings[static_cast<std::size_t>(v.stringIndex)];
     const double dt = 1.0 / fs_;
     const double liftStep = dt / std::max(0.005, static_cast<double>(params_[static_cast<int>(Param::ReleaseTime)]));
-    const double boostDecay = std::exp(-dt / boostSeconds);
     const float gl = v.gainL * v.volume * v.volume, gr = v.gainR * v.volume * v.volume;
     float theta = v.lastTemperature;
+    const bool tapped = tapVoice_ == &v;
     for (int i = 0; i < n; ++i) {
         if (v.untilControl-- <= 0) {
             updateControl(v);
             v.untilControl = controlInterval - 1;
         }
-        // Speed: Guettler's constant acceleration up to the target, then follow it smoothly. A
-        // controller's hand is its own acceleration (and may reverse): follow it.
-        if (external_.active) v.speed += (v.targetSpeed - v.speed) * smoothing_;
-        else if (v.speed < v.targetSpeed) v.speed = std::min(v.targetSpeed, v.speed + v.accel * dt);
-        else v.speed += (v.targetSpeed - v.speed) * smoothing_;
-        v.force += (v.targetForce * (external_.active ? 1.0 : 1.0 + v.boost) - v.force) * smoothing_;
-        v.boost *= boostDecay;
-        if (v.released) {
-            if (v.lift > 0.0) v.lift = std::max(0.0, v.lift - liftStep);
-            else v.fade *= ringCoefficient_;
+        double pluck = 0.0;
+        bool bowOff = false;
+        if (external_.active) { // a controller's hand is its own gesture (and may reverse): follow it
+            v.speed += (v.targetSpeed - v.speed) * smoothing_;
+            v.force += (v.targetForce - v.force) * smoothing_;
+            if (v.released) v.lift = std::max(0.0, v.lift - liftStep);
+            bowOff = v.released && v.lift <= 0.0;
+        } else {
+            v.aimForce += (v.targetForce - v.aimForce) * smoothing_;
+            const dsp::GestureFrame g = v.gesture.next({v.aimForce, v.targetSpeed, v.beta});
+            v.speed = g.speed;
+            v.force = g.force;
+            v.lift = 1.0;
+            pluck = g.pluck;
+            bowOff = v.gesture.off();
         }
+        if (v.released && bowOff) v.fade *= ringCoefficient_;
         dsp::BowFrame<float> frame;
-        const float y = string.processSample(static_cast<float>(v.force * v.lift), static_cast<float>(v.speed),
-                                             static_cast<float>(v.beta), &frame);
+        float y = 0.0f;
+        if (pluck != 0.0) { // the finger or the stick pushes the string; no friction
+            string.waveguide().setBeta(v.beta);
+            string.processForce(static_cast<float>(pluck));
+            y = string.waveguide().bridgeForce();
+            frame.stick = false;
+        } else {
+            y = string.processSample(static_cast<float>(v.force * v.lift), static_cast<float>(v.speed), static_cast<float>(v.beta), &frame);
+        }
         theta = frame.temperature;
         listen(v, frame.stick);
+        if (tapped && tapCount_ < tapCapacity_) {
+            tapBridge_[tapCount_] = y;
+            if (tapStick_) tapStick_[tapCount_] = frame.stick ? 1 : 0;
+            ++tapCount_;
+        }
         const float out = static_cast<float>(y * v.fade);
         busL[i] += gl * out;
         busR[i] += gr * out;
         const double a = std::abs(static_cast<double>(out));
         v.peak = std::max(v.peak, a);
-        if (v.released && v.lift <= 0.0 && v.fade < silence) {
+        if (v.released && bowOff && v.fade < silence) {
             v.active = false;
             string.reset();
+            if (tapped) tapVoice_ = nullptr;
             break;
         }
     }
@@ -615,6 +703,8 @@ VoiceInfo Synth::voiceInfo(int index) const noexcept
     info.frequency = v.frequency;
     info.correctionCents = v.correctionCents;
     info.force = v.force * v.lift;
+    info.bowDirection = v.speed > 0.0 ? 1 : v.speed < 0.0 ? -1 : 0;
+    info.bowPosition = v.gesture.bowPosition();
     info.speed = v.speed;
     info.beta = v.beta;
     info.temperature = v.lastTemperature;

@@ -35,6 +35,13 @@ public:
     /// [setup thread] No allocation: the mode array is fixed.
     void prepare(double sampleRate, const BodyParams& params) noexcept
     {
+        retune(sampleRate, params);
+        reset();
+    }
+
+    /// [audio thread] New modes (a mute on the bridge) without clearing what is ringing.
+    void retune(double sampleRate, const BodyParams& params) noexcept
+    {
         params_ = params;
         active_ = 0;
         for (int p = 0; p < maxPacks; ++p) g_[p] = k_[p] = a1_[p] = gain_[p] = Pack{};
@@ -54,7 +61,8 @@ public:
         packs_ = (active_ + lanes - 1) / lanes;
         direct_ = static_cast<T>(params.direct);
         scale_ = static_cast<T>(params.outputScale);
-        reset();
+        // Modes that vanished keep no energy behind.
+        for (int p = packs_; p < maxPacks; ++p) ic1_[p] = ic2_[p] = Pack{};
     }
 
     void reset() noexcept

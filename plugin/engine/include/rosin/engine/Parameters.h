@@ -31,6 +31,14 @@ enum class Param : int {
     Gain,            ///< output gain (dB)
     Mpe,             ///< 0 off, 1 on (lower zone, 15 member channels) until an MCM says otherwise
     Intonation,      ///< 0: the string's own pitch (flattens with force); 1: the finger corrects by ear
+    Articulation,    ///< dsp::Articulation: detache, martele, spiccato, tremolo, col legno, pizzicato
+    TremoloRate,     ///< bow strokes per second
+    SpiccatoRate,    ///< bounces per second
+    BowLength,       ///< usable hair (m): long notes change bow when it runs out
+    VibratoAuto,     ///< automatic vibrato amount (0-1 of vibrato_depth), besides CC1
+    VibratoDelay,    ///< s after the note start before the automatic vibrato sets in
+    Mute,            ///< sordino: a mass on the bridge
+    ArticulationChannels, ///< 0 off, 1: MIDI channel n plays articulation n (1 = detache)
     Count
 };
 

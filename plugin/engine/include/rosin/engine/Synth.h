@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rosin/dsp/Body.h"
+#include "rosin/dsp/BowGesture.h"
 #include "rosin/dsp/BowedString.h"
 #include "rosin/engine/ControllerMap.h"
 #include "rosin/engine/Parameters.h"
@@ -35,6 +36,8 @@ struct VoiceInfo {
     bool keyDown = false, released = false;
     double frequency = 0.0;   ///< stopped-string fundamental (Hz) after bend, glide, vibrato, intonation
     double correctionCents = 0.0; ///< how far the finger moved to correct the pitch by ear
+    int bowDirection = 0;         ///< +1 down bow, -1 up bow, 0 still
+    double bowPosition = 0.0;     ///< where on the bow the string is (m from the frog)
     double force = 0.0, speed = 0.0, beta = 0.0; ///< what the string got last sample
     double temperature = 0.0; ///< contact temperature rise (K)
 };
@@ -79,6 +82,13 @@ public:
     /// The string a note of `frequency` goes to: policy, a preferred string (stay-on-string, or
     /// -1), and a mask of strings already sounding (a free string is preferred, as in a chord).
     int chooseString(double frequency, int preferred, unsigned occupiedMask) const noexcept;
+
+    /// Analysis tap: the next voice to start writes its bridge force (N, before body and pan)
+    /// and stick flags into these caller-owned buffers, up to `capacity` samples.
+    void setVoiceTap(float* bridgeForce, std::uint8_t* stick, int capacity) noexcept;
+    int voiceTapCount() const noexcept { return tapCount_; }
+    /// Lowest MIDI note that is a keyswitch (C0); articulation n is this note + n.
+    static constexpr int keyswitchBase = 12;
     double noteFrequency(double midiNote) const noexcept;
 
 private:
@@ -105,9 +115,10 @@ private:
         std::array<int, 8> held{}; ///< legato note stack on this voice (top = sounding)
         int heldCount = 0;
         double pitch = 0.0, glideTarget = 0.0, glideStep = 0.0; ///< MIDI note numbers
-        double speed = 0.0, force = 0.0, boost = 0.0, lift = 1.0, fade = 1.0;
+        dsp::BowGesture gesture; ///< the right arm: articulation, bow direction, bow length
+        double speed = 0.0, force = 0.0, aimForce = 0.0, lift = 1.0, fade = 1.0, age = 0.0;
         double targetForce = 0.0, targetSpeed = 0.0, beta = 0.1, frequency = 0.0;
-        double vibratoPhase = 0.0, accel = 1.0, peak = 0.0, quietSamples = 0.0;
+        double vibratoPhase = 0.0, peak = 0.0;
         float gainL = 0.7f, gainR = 0.7f, volume = 1.0f;
         int untilControl = 0;
         float lastTemperature = 0.0f;
@@ -150,6 +161,15 @@ private:
     dsp::FrictionModel appliedModel_ = dsp::FrictionModel::Thermal;
     int tag_ = -1;
     ExternalBow external_;
+    std::array<double, maxStrings> forceScale_{}; ///< Z0(string) / Z0(third string): same place in Schelleng's diagram
+    std::array<int, 16> nextDirection_{};      ///< per channel: the next note's bow direction
+    std::array<double, 16> bowPosition_{};     ///< per channel: where on the bow the last note ended (m)
+    float* tapBridge_ = nullptr;
+    std::uint8_t* tapStick_ = nullptr;
+    int tapCapacity_ = 0, tapCount_ = 0;
+    const Voice* tapVoice_ = nullptr;
+    bool tapArmed_ = false;
+    void applyBody() noexcept;
 };
 
 } // namespace rosin::engine
