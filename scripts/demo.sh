@@ -8,11 +8,23 @@ bash scripts/install-deps.sh
 bash scripts/build.sh
 mkdir -p out
 ./build/lab/rosin render --midi presets/midi/demo-phrase.mid --preset cello --out out/demo-phrase.wav
+# One short phrase per articulation (keyswitches choose them; legato and the mute are parameters).
+mkdir -p out/articulations
+for f in presets/midi/articulations/*.mid; do
+  name=$(basename "$f" .mid)
+  case "$name" in
+    legato) ./build/plugin/rosin-host render --plugin build/plugin/RosinPlugin_artefacts/Release/VST3/Rosin.vst3 \
+              --midi "$f" --preset violin --set legato=@1 --out "out/articulations/$name.wav" ;;
+    *) ./build/lab/rosin render --midi "$f" --preset violin --out "out/articulations/$name.wav" ;;
+  esac
+done
+./build/plugin/rosin-host render --plugin build/plugin/RosinPlugin_artefacts/Release/VST3/Rosin.vst3 \
+  --midi presets/midi/articulations/detache.mid --preset violin --set mute=@1 --out out/articulations/sordino.wav
 ./build/lab/rosin render --gesture-file presets/gestures/demo-phrase.csv --sample-rate 48000 --listen \
   --out out/gesture-phrase
 ./build/lab/rosin render --model enhanced --gesture guettler --force 1.0 --accel 1.0 --duration 0.3 \
   --out out/guettler-stroke
 ./build/lab/rosin guettler --model thermal --fit wg --variants 5 --out out/guettler-thermal
-echo "demo: listen to out/demo-phrase.wav (the cello plays presets/midi/demo-phrase.mid);"
+echo "demo: listen to out/demo-phrase.wav (the cello plays presets/midi/demo-phrase.mid) and out/articulations/*.wav;"
 echo "      look at out/guettler-thermal.png (data beside it); out/gesture-phrase.wav is one string under a"
 echo "      bowing gesture, out/guettler-stroke.{wav,csv} one stroke in newtons; rosin figures -o out/figures draws the set"

@@ -79,7 +79,7 @@ public:
             // A finger pulls the string aside (3 ms) and lets go; the stick strikes (1 ms). The
             // pulse's size follows velocity; the bow never holds the string.
             const double width = articulation_ == Articulation::Pizzicato ? 0.003 : 0.001;
-            const double peak = (articulation_ == Articulation::Pizzicato ? 1.5 : 3.0) * (0.2 + velocity_);
+            const double peak = (articulation_ == Articulation::Pizzicato ? 1.5 : 0.8) * (0.2 + velocity_);
             if (t_ <= width) f.pluck = peak * std::sin(std::numbers::pi * t_ / width);
             return f;
         }
