@@ -59,9 +59,9 @@ TEST(Articulation, KeyswitchControllerAndChannelChooseIt)
     midi(*s, {0x90, Synth::keyswitchBase + 2, 100}); // C0+2: spiccato
     EXPECT_FLOAT_EQ(s->parameter(static_cast<int>(Param::Articulation)), 2.0f);
     EXPECT_EQ(s->activeVoiceCount(), 0); // a keyswitch makes no sound
-    midi(*s, {0xB0, 20, 127});           // CC20 top of the range: pizzicato
-    EXPECT_FLOAT_EQ(s->parameter(static_cast<int>(Param::Articulation)), 5.0f);
-    midi(*s, {0xB0, 20, 30});            // 30/128 of six: martele
+    midi(*s, {0xB0, 20, 127});           // CC20 top of the range: harmonic
+    EXPECT_FLOAT_EQ(s->parameter(static_cast<int>(Param::Articulation)), 6.0f);
+    midi(*s, {0xB0, 20, 30});            // 30/128 of seven: martele
     EXPECT_FLOAT_EQ(s->parameter(static_cast<int>(Param::Articulation)), 1.0f);
 }
 
@@ -285,4 +285,24 @@ TEST(Articulation, DefaultVelocityReachesHelmholtzOnEveryString)
             EXPECT_LE(c.transientPeriods, 20) << name << " string " << string;
         }
     }
+}
+
+TEST(Articulation, HarmonicsSoundAtTheHarmonicsPitch)
+{
+    // Natural: D5 is the D string's second harmonic (open string, a light finger at its middle).
+    // Artificial: C7 is C5 stopped and touched a fourth above (the 4th harmonic).
+    for (const int note : {74, 79, 88, 95, 96}) { // natural n=2 (D, E), n=3 (E); artificial: a fifth on G, a fourth on A
+        auto s = make("violin", with({{Param::Articulation, 6.0f}}));
+        midi(*s, {0x90, note, 100});
+        const auto out = play(*s, 1.5);
+        const double target = test::midiToHz(note);
+        const double f = test::pitchHz(out, fs, fs / 2, 3 * fs / 2, 0.6 * target, 3.0 * target); // an octave above is searched too
+        EXPECT_LT(std::abs(test::cents(f, test::midiToHz(note))), 10.0) << note << ": " << f << " Hz";
+        EXPECT_GT(test::rms(out, fs / 2, 3 * fs / 2), 1e-3) << note;
+    }
+    auto s = make("violin");
+    int string = -1;
+    EXPECT_EQ(s->chooseHarmonic(test::midiToHz(74), string), 2);
+    EXPECT_EQ(string, 1); // the D string (G=0, D=1, A=2, E=3)
+    EXPECT_EQ(s->chooseHarmonic(test::midiToHz(96), string), 4);
 }

@@ -175,3 +175,44 @@ TEST(ModalBody, ModesOutsideTheBandAreDroppedNotUnstable)
     EXPECT_TRUE(std::isfinite(y));
     EXPECT_LT(std::abs(y), 1e-3f);
 }
+
+// A light finger at the node of harmonic n: bowed, the string speaks n f0 (natural harmonics).
+TEST(PlayableVoice, ALightFingerAtANodeSoundsTheHarmonic)
+{
+    const double fs = 48000.0;
+    for (int n : {2, 3, 4}) {
+        BowedStringConfig c;
+        c.friction.model = FrictionModel::Thermal;
+        BowedString<double> s;
+        s.prepare(fs, c);
+        s.waveguide().setHarmonic(n, 1.0);
+        const auto a = stroke(s, 36000, 0.3, 0.2, 0.06);
+        auto corr = [&](int lag) {
+            double r = 0.0;
+            for (std::size_t i = 18000; i + static_cast<std::size_t>(lag) < a.size(); ++i) r += a[i] * a[i + static_cast<std::size_t>(lag)];
+            return r;
+        };
+        const double target = n * c.string.fundamental();
+        const int expect = static_cast<int>(fs / target);
+        int best = expect - 6;
+        for (int lag = expect - 6; lag <= expect + 6; ++lag)
+            if (corr(lag) > corr(best)) best = lag;
+        const double r0 = corr(best - 1), r1 = corr(best), r2 = corr(best + 1);
+        const double period = best + 0.5 * (r0 - r2) / (r0 - 2.0 * r1 + r2);
+        EXPECT_LT(std::abs(1200.0 * std::log2(fs / period / target)), 10.0) << "harmonic " << n;
+        // Periodic at the harmonic's period, not only at the open string's: as strong at P/n as at P.
+        const int open = static_cast<int>(std::lround(fs / c.string.fundamental()));
+        EXPECT_GT(corr(best), 0.8 * corr(open)) << n;
+        EXPECT_GT(peak(a), 0.02) << n;
+        // The control: without the finger the same bow plays the open string, and the test sees it.
+        BowedString<double> plain;
+        plain.prepare(fs, c);
+        const auto b = stroke(plain, 36000, 0.3, 0.2, 0.06);
+        auto corrB = [&](int lag) {
+            double r = 0.0;
+            for (std::size_t i = 18000; i + static_cast<std::size_t>(lag) < b.size(); ++i) r += b[i] * b[i + static_cast<std::size_t>(lag)];
+            return r;
+        };
+        EXPECT_LT(corrB(best), 0.8 * corrB(open)) << n;
+    }
+}

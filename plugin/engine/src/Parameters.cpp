@@ -32,7 +32,7 @@ constexpr std::array<ParamInfo, paramCount> table{{
     {"gain", "Output gain", "dB", -60.0f, 12.0f, 0.0f, -12.0f, 0, ""},
     {"mpe", "MPE", "", 0.0f, 1.0f, 0.0f, 0.5f, 2, "Off|On"},
     {"intonation", "Intonation by ear", "", 0.0f, 1.0f, 1.0f, 0.5f, 0, ""},
-    {"articulation", "Articulation", "", 0.0f, 5.0f, 0.0f, 2.5f, 6, "Detache|Martele|Spiccato|Tremolo|Col legno|Pizzicato"},
+    {"articulation", "Articulation", "", 0.0f, 6.0f, 0.0f, 3.0f, 7, "Detache|Martele|Spiccato|Tremolo|Col legno|Pizzicato|Harmonic"},
     {"tremolo_rate", "Tremolo rate", "strokes/s", 2.0f, 20.0f, 8.0f, 8.0f, 0, ""},
     {"spiccato_rate", "Spiccato rate", "bounces/s", 2.0f, 15.0f, 7.0f, 7.0f, 0, ""},
     {"bow_length", "Bow length", "m", 0.2f, 0.75f, 0.65f, 0.5f, 0, ""},

@@ -14,6 +14,7 @@ constexpr double controlSmoothingSeconds = 0.01; ///< force/speed/gain one-pole 
 constexpr double betaSmoothingSeconds = 0.02;    ///< at control rate: beta redesigns the loss filters
 constexpr double ringSeconds = 0.6;              ///< 60 dB decay of a string after the bow lifts
 constexpr double silence = 1e-5;                 ///< -100 dB: the voice is free
+constexpr double harmonicTouch = 3.0;            ///< the light finger's resistance, x Z0 [A]
 constexpr int memberBendRange = 48, masterBendRange = 2; ///< MPE defaults (M1-100-UM)
 
 /// Flush denormals to zero for the scope (the string's losses decay into them after release).
@@ -150,6 +151,31 @@ int Synth::chooseString(double frequency, int preferred, unsigned occupiedMask) 
         for (int s = n - 1; s >= 0; --s)
             if (reachable(s) && (pass == 1 || !(occupiedMask & (1u << s)))) return s;
     return frequency < open(0) ? 0 : n - 1; // below the instrument: the lowest string, tuned down
+}
+
+int Synth::chooseHarmonic(double frequency, int& string) const noexcept
+{
+    // Natural harmonics an octave and a twelfth up (the ones that speak readily on an open
+    // string); beyond that an artificial harmonic: a stopped note touched a fourth (n = 4), a
+    // fifth (3) or an octave (2) above, on a string that is really stopped.
+    for (int n = 2; n <= 3; ++n)
+        for (int s = instrument_.stringCount - 1; s >= 0; --s) {
+            const double open = instrument_.strings[static_cast<std::size_t>(s)].fundamental();
+            if (std::abs(1200.0 * std::log2(frequency / (n * open))) < 30.0) {
+                string = s;
+                return n;
+            }
+        }
+    for (int n = 4; n >= 2; --n) {
+        const int s = chooseString(frequency / n, -1, 0u);
+        const double open = instrument_.strings[static_cast<std::size_t>(s)].fundamental();
+        if (frequency / n > open * std::exp2(1.0 / 12.0)) { // at least a semitone up: a finger stops it
+            string = s;
+            return n;
+        }
+    }
+    string = 0;
+    return 2;
 }
 
 bool Synth::mpeMemberChannel(int channel) const noexcept { return masterOf(channel) >= 0; }
@@ -368,7 +394,15 @@ void Synth::noteOn(int ch, int note, int velocity) noexcept
 void Synth::startVoice(Voice& v, int ch, int note, int velocity, int s) noexcept
 {
     if (v.active) v.strings[static_cast<std::size_t>(v.stringIndex)].reset(); // stolen
+    v.harmonic = 0;
+    if (static_cast<int>(params_[static_cast<int>(Param::Articulation)]) == static_cast<int>(dsp::Articulation::Harmonic) &&
+        !(params_[static_cast<int>(Param::ArticulationChannels)] > 0.5f)) {
+        int hs = s;
+        v.harmonic = chooseHarmonic(noteFrequency(note), hs);
+        s = hs;
+    }
     v.strings[static_cast<std::size_t>(s)].reset();
+    v.strings[static_cast<std::size_t>(s)].waveguide().setHarmonic(v.harmonic, harmonicTouch);
     v.active = true;
     v.keyDown = true;
     v.sustained = false;
@@ -564,7 +598,8 @@ void Synth::updateControl(Voice& v) noexcept
     // Re-stopping redesigns the loss filters: skip moves below 0.02 cent (the ear's correction
     // creeps by less than that between periods once it has settled).
     auto& waveguide = v.strings[static_cast<std::size_t>(v.stringIndex)].waveguide();
-    if (std::abs(v.frequency - waveguide.fundamental()) > 1e-5 * v.frequency) waveguide.setFundamental(v.frequency);
+    const double stopped = v.harmonic > 0 ? v.frequency / v.harmonic : v.frequency; // a harmonic: the string under it
+    if (std::abs(stopped - waveguide.fundamental()) > 1e-5 * stopped) waveguide.setFundamental(stopped);
 }
 
 void Synth::renderVoice(Voice& v, float* busL, float* busR, int n) noexcept

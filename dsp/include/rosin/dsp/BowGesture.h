@@ -9,7 +9,7 @@
 
 namespace rosin::dsp {
 
-enum class Articulation { Detache = 0, Martele, Spiccato, Tremolo, ColLegno, Pizzicato, Count };
+enum class Articulation { Detache = 0, Martele, Spiccato, Tremolo, ColLegno, Pizzicato, Harmonic, Count };
 
 struct GestureSettings {
     double bowLength = 0.65;       ///< usable hair (m): a violin bow has about 65 cm
@@ -120,11 +120,14 @@ public:
             return bowOut(f, aim.force * lift_);
         }
         case Articulation::Detache:
+        case Articulation::Harmonic: // bowed like detache; the left hand makes the harmonic
         default: {
             if (speedMag_ < aim.speed) speedMag_ = std::min(aim.speed, speedMag_ + settings_.acceleration * std::max(0.05, velocity_) * dt);
             else speedMag_ += (aim.speed - speedMag_) * (1.0 - std::exp(-dt / 0.01));
             boost_ *= std::exp(-dt / 0.08);
-            force_ = aim.force * (1.0 + boost_);
+            // Harmonics speak with a lighter bow (the touched string has less to hold).
+            const double light = articulation_ == Articulation::Harmonic ? 0.5 : 1.0;
+            force_ = aim.force * light * (1.0 + boost_);
             // The bow runs out: turn round before the tip or the frog.
             const double margin = speedMag_ * settings_.bowChangeTime * 0.5;
             if (changing_ <= 0.0 && ((direction_ > 0 && position_ >= settings_.bowLength - margin) ||

@@ -50,8 +50,9 @@ public:
         const double ratio = std::clamp(options.lowestPitchRatio, 0.05, 1.0);
         const double period = fs_ / (f0_ * ratio);
         lowestFundamental_ = f0_ * ratio;
-        for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_})
+        for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_, &nodeBack_, &nodeRound_})
             line->prepare(period / std::min(1.0, params.torsionSpeedRatio) + 16.0);
+        harmonic_ = 0;
         designDispersion();
         beta_ = -1.0;
         setBeta(0.0899);
@@ -60,7 +61,7 @@ public:
 
     void reset() noexcept
     {
-        for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_})
+        for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_, &nodeBack_, &nodeRound_})
             line->reset();
         for (auto* f : {&lossBridge_, &lossFinger_, &lossTorsionBridge_, &lossTorsionFinger_}) f->reset();
         dispersion_.reset();
@@ -87,6 +88,20 @@ public:
         beta_ = -1.0;
         setBeta(beta);
     }
+
+    /// [audio thread] A light finger touching the string at the node of harmonic n (n >= 2; 0 =
+    /// no touch): a point damper of resistance `damping` x Z0 at L/n from the finger end. Modes
+    /// with a node there pass; the others are damped, so the string speaks its n-th harmonic.
+    void setHarmonic(int n, double damping = 1.0) noexcept
+    {
+        n = n >= 2 && n <= 16 ? n : 0;
+        const double r = std::clamp(std::isfinite(damping) ? damping : 1.0, 0.01, 100.0);
+        if (n == harmonic_ && r == nodeDamping_) return;
+        harmonic_ = n;
+        nodeDamping_ = r;
+        designNode();
+    }
+    int harmonic() const noexcept { return harmonic_; }
 
     /// [audio thread] Moves the bow point. Cheap closed-form redesign; skipped when unchanged.
     void setBeta(double beta) noexcept
@@ -115,6 +130,7 @@ public:
         tapTorsionBridge_ = torsionBridge_.tap(delayTorsionBridge_);
         tapTorsionFinger_ = torsionFinger_.tap(delayTorsionFinger_);
         tapFarEnd_ = fingerSide_.tap(0.5 * tau2 * fs_); // one way, bow to finger
+        designNode();
         if (options_.gaussianReflections) {
             auto design = [&](GaussianReflection<T>& g, double delay, double tau, bool torsional) {
                 const double etaLow = torsional ? 1.0 / params_.qTorsion
@@ -142,7 +158,17 @@ public:
         if (options_.gaussianReflections) return beginSampleGaussian(arriving);
         u1In_ = bridgeBack_.read(tapBridgeBack_);
         bridgeBack_.write(reflected);
-        u2In_ = -lossFinger_.process(dispersion_.process(fingerSide_.read(tapFinger_)));
+        if (harmonic_ > 0) {
+            // Finger side split at the touched node: bow <-> node (A), node <-> finger end (B).
+            const T aIn = fingerSide_.read(tapNodeA_);
+            const T bIn = -lossFinger_.process(dispersion_.process(nodeRound_.read(tapNodeRound_)));
+            const T v = nodeGain_ * (aIn + bIn); // 2Z (a + b) / (2Z + R)
+            u2In_ = nodeBack_.read(tapNodeBack_);
+            nodeBack_.write(v - aIn);
+            nodeRound_.write(v - bIn);
+        } else {
+            u2In_ = -lossFinger_.process(dispersion_.process(fingerSide_.read(tapFinger_)));
+        }
         if (options_.torsion) {
             u1tIn_ = -lossTorsionBridge_.process(torsionBridge_.read(tapTorsionBridge_));
             u2tIn_ = -lossTorsionFinger_.process(torsionFinger_.read(tapTorsionFinger_));
@@ -229,6 +255,20 @@ private:
         filter.design(segmentMagnitude(f0_, tau, etaLow), w0_, segmentMagnitude(fLossProbe_, tau, etaHigh), wLossProbe_);
     }
 
+    void designNode() noexcept
+    {
+        if (harmonic_ <= 0) return;
+        const double c = params_.waveSpeed(), L = params_.length;
+        const double fromBow = std::max(L * (1.0 - 1.0 / harmonic_) - beta_ * L, 0.5 * c / fs_); // node beyond the bow
+        const double beyond = L / harmonic_;
+        const double delayA = fromBow / c * fs_;
+        const double delayB = 2.0 * beyond / c * fs_ - lossFinger_.phaseDelay(w0_) - dispersion_.phaseDelay(w0_);
+        tapNodeA_ = fingerSide_.tap(delayA);
+        tapNodeBack_ = nodeBack_.tap(delayA);
+        tapNodeRound_ = nodeRound_.tap(std::max(delayB, config::minSegmentDelay));
+        nodeGain_ = static_cast<T>(2.0 / (2.0 + nodeDamping_));
+    }
+
     /// Fits the allpass coefficient so the partials follow a stiff string, f_n / f_1 =
     /// n sqrt((1 + B n^2) / (1 + B)), with the fundamental kept at f0.
     void designDispersion()
@@ -266,12 +306,16 @@ private:
     double z0_ = 0.5, zt_ = 1.0, beta_ = -1.0, lowestFundamental_ = 20.0;
     StringParams params_;
     WaveguideOptions options_;
-    DelayLine<T> bridgeOut_, bridgeBack_, fingerSide_, torsionBridge_, torsionFinger_;
+    DelayLine<T> bridgeOut_, bridgeBack_, fingerSide_, torsionBridge_, torsionFinger_, nodeBack_, nodeRound_;
+    int harmonic_ = 0;
+    double nodeDamping_ = 1.0;
+    T nodeGain_ = T(1);
     OnePoleLoss<T> lossBridge_, lossFinger_, lossTorsionBridge_, lossTorsionFinger_;
     DispersionChain<T> dispersion_;
     GaussianReflection<T> gaussBridge_, gaussFinger_, gaussTorsionBridge_, gaussTorsionFinger_;
     double delayBridgeOut_ = 1, delayBridgeBack_ = 1, delayFinger_ = 1, delayTorsionBridge_ = 1, delayTorsionFinger_ = 1;
     typename DelayLine<T>::Tap tapBridgeOut_, tapBridgeBack_, tapFinger_, tapTorsionBridge_, tapTorsionFinger_, tapFarEnd_;
+    typename DelayLine<T>::Tap tapNodeA_, tapNodeBack_, tapNodeRound_;
     T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0), farEndForce_ = T(0);
 };
 

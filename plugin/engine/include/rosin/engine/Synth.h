@@ -82,6 +82,9 @@ public:
     /// The string a note of `frequency` goes to: policy, a preferred string (stay-on-string, or
     /// -1), and a mask of strings already sounding (a free string is preferred, as in a chord).
     int chooseString(double frequency, int preferred, unsigned occupiedMask) const noexcept;
+    /// Where to play a harmonic at `frequency`: a natural one (string s, n = 2-4, open string) or
+    /// else an artificial one (stopped at f/4, touched a fourth above: n = 4). Returns n.
+    int chooseHarmonic(double frequency, int& string) const noexcept;
 
     /// Analysis tap: the next voice to start writes its bridge force (N, before body and pan)
     /// and stick flags into these caller-owned buffers, up to `capacity` samples.
@@ -116,6 +119,7 @@ private:
         int heldCount = 0;
         double pitch = 0.0, glideTarget = 0.0, glideStep = 0.0; ///< MIDI note numbers
         dsp::BowGesture gesture; ///< the right arm: articulation, bow direction, bow length
+        int harmonic = 0;        ///< n when a light finger makes the n-th harmonic, else 0
         double speed = 0.0, force = 0.0, aimForce = 0.0, lift = 1.0, fade = 1.0, age = 0.0;
         double targetForce = 0.0, targetSpeed = 0.0, beta = 0.1, frequency = 0.0;
         double vibratoPhase = 0.0, peak = 0.0;
