@@ -151,11 +151,11 @@ engine::ParamValues RosinProcessor::currentParams() const
     return v;
 }
 
-std::unique_ptr<engine::Synth> RosinProcessor::buildSynth(const juce::String& instrument, double sampleRate) const
+std::unique_ptr<engine::Synth> RosinProcessor::buildSynth(const engine::InstrumentPreset& preset, double sampleRate, int tag)
 {
-    const auto preset = engine::loadInstrument(presetDir_.getFullPathName().toStdString(), instrument.toStdString());
     auto synth = std::make_unique<engine::Synth>();
-    synth->prepare(sampleRate, preset, currentParams(), const_cast<engine::ControllerMap*>(&map_));
+    synth->prepare(sampleRate, preset, currentParams(), &map_);
+    synth->setTag(tag);
     return synth;
 }
 
@@ -239,10 +239,7 @@ void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults
     const double rate = sampleRate_.load();
     if (rate > 0.0) {
         collectGarbage();
-        auto synth = std::make_unique<engine::Synth>();
-        synth->prepare(rate, preset, currentParams(), &map_);
-        synth->setTag(index);
-        handOver(std::move(synth));
+        handOver(buildSynth(preset, rate, index));
     }
 }
 
@@ -287,8 +284,8 @@ void RosinProcessor::prepareToPlay(double sampleRate, int maximumExpectedSamples
     const int index = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(instrumentRaw_->load()));
     instrumentName_ = instrumentNames()[index];
     try {
-        current_ = buildSynth(instrumentName_, sampleRate).release();
-        current_->setTag(index);
+        const auto preset = engine::loadInstrument(presetDir_.getFullPathName().toStdString(), instrumentName_.toStdString());
+        current_ = buildSynth(preset, sampleRate, index).release();
     } catch (const std::exception& e) {
         DBG("Rosin: " << e.what()); // no engine: processBlock outputs silence
     }

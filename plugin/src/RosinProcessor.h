@@ -73,7 +73,7 @@ public:
 private:
     class Loader;
     static juce::AudioProcessorValueTreeState::ParameterLayout createLayout();
-    std::unique_ptr<engine::Synth> buildSynth(const juce::String& instrument, double sampleRate) const;
+    std::unique_ptr<engine::Synth> buildSynth(const engine::InstrumentPreset& preset, double sampleRate, int tag);
     void handOver(std::unique_ptr<engine::Synth> synth);
     void collectGarbage();
     void pollHid(); ///< [loader thread] start or stop the HID input with its parameter

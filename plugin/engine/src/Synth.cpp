@@ -53,7 +53,6 @@ void Synth::prepare(double sampleRate, const InstrumentPreset& instrument, const
         c.friction.thermal.footprintRatio = params_[static_cast<int>(Param::Footprint)];
         templates[static_cast<std::size_t>(s)].prepare(sampleRate, c);
     }
-    appliedModel_ = static_cast<dsp::FrictionModel>(static_cast<int>(params_[static_cast<int>(Param::FrictionModel)]));
     for (auto& v : voices_)
         for (int s = 0; s < instrument.stringCount; ++s) v.strings[static_cast<std::size_t>(s)] = templates[static_cast<std::size_t>(s)];
 
@@ -123,7 +122,6 @@ void Synth::applyFriction() noexcept
             j.setAmbient(params_[static_cast<int>(Param::Ambient)]);
             j.setFootprintRatio(params_[static_cast<int>(Param::Footprint)]);
         }
-    appliedModel_ = model;
 }
 
 double Synth::noteFrequency(double midiNote) const noexcept
@@ -244,7 +242,7 @@ void Synth::controlChange(int ch, int cc, int value) noexcept
     if (cc == 100) { c.rpnLsb = value; return; }
     if (cc == 99 || cc == 98) { c.rpnMsb = c.rpnLsb = 127; return; }
     if ((cc == 6 || cc == 38) && !(c.rpnMsb == 127 && c.rpnLsb == 127)) {
-        dataEntry(ch, 0.0f, cc == 6, value);
+        dataEntry(ch, cc == 6, value);
         return;
     }
     // 14-bit pairs: 0-31 MSB, 32-63 LSB. A new MSB clears the LSB; an LSB refines the MSB.
@@ -266,7 +264,7 @@ void Synth::controlChange(int ch, int cc, int value) noexcept
     controller(ch, cc, static_cast<float>(value) / 127.0f);
 }
 
-void Synth::dataEntry(int ch, float, bool coarse, int value) noexcept
+void Synth::dataEntry(int ch, bool coarse, int value) noexcept
 {
     ChannelState& c = channels_[static_cast<std::size_t>(ch)];
     if (c.rpnMsb != 0) return;

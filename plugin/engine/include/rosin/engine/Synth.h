@@ -136,7 +136,7 @@ private:
     void noteOff(int channel, int note) noexcept;
     void controller(int channel, int cc, float value) noexcept;
     void controlChange(int channel, int cc, int value) noexcept;
-    void dataEntry(int channel, float semitones, bool coarse, int value) noexcept;
+    void dataEntry(int channel, bool coarse, int value) noexcept;
     void sustainOff(int channel) noexcept;
     void releaseVoice(Voice& v) noexcept;
     void startVoice(Voice& v, int channel, int note, int velocity, int stringIndex) noexcept;
@@ -162,7 +162,6 @@ private:
     std::vector<float> busL_, busR_;
     double gain_ = 1.0, gainTarget_ = 1.0, bodyMix_ = 1.0, smoothing_ = 0.0, betaSmoothing_ = 0.0;
     double ringCoefficient_ = 0.999;
-    dsp::FrictionModel appliedModel_ = dsp::FrictionModel::Thermal;
     int tag_ = -1;
     ExternalBow external_;
     std::array<double, maxStrings> forceScale_{}; ///< Z0(string) / Z0(third string): same place in Schelleng's diagram
