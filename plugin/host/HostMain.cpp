@@ -12,6 +12,7 @@
 
 #include "AuditCounter.h"
 #include "PluginHost.h"
+#include "rosin/engine/Presets.h"
 #include "rosin/hid/HidInput.h"
 
 #include <chrono>
@@ -79,7 +80,7 @@ int main(int argc, char** argv)
     render->add_option("--seconds", seconds, "length (default: last event + tail)")->check(CLI::Range(0.0, 3600.0));
     render->add_option("--tail", tail, "seconds after the last event")->check(CLI::Range(0.0, 60.0));
     std::string preset;
-    render->add_option("--preset", preset, "instrument preset: violin, viola, cello or double-bass");
+    render->add_option("--preset", preset, "instrument preset: violin, viola, cello or double-bass (with its bow and rosin)");
     render->add_option("--set", sets, "parameter before playing: ID=VALUE in its units, or ID=@0.5 normalised (repeatable)");
     render->add_option("--automation", automationFile, "CSV seconds,param_id,normalised (applied per block)");
     render->add_option("--state-in", stateIn, "plugin state to load first (from --state-out)");
@@ -184,10 +185,17 @@ int main(int argc, char** argv)
         if (!automationFile.empty()) req.automation = readAutomation(automationFile);
         if (!stateIn.empty()) host.setState(readBytes(stateIn));
         if (!preset.empty()) {
+            // As a player choosing the preset: the instrument, and the bow and rosin it suggests.
+            const auto p = rosin::engine::loadInstrument(rosin::engine::presetDirectory(), preset);
             host.setParameter("instrument", preset);
             if (host.parameter("instrument").text != preset)
                 throw std::runtime_error("--preset " + preset + ": the plugin has no such instrument (it shows '" +
                                          host.parameter("instrument").text + "')");
+            host.setParameter("bow_force", std::to_string(p.bowForce));
+            host.setParameter("bow_speed", std::to_string(p.bowSpeed));
+            host.setParameter("bow_position", std::to_string(p.bowPosition));
+            host.setParameter("attack_accel", std::to_string(p.attackAccel));
+            host.setParameter("rosin_tg", std::to_string(p.rosinTg));
         }
         for (const auto& s : sets) {
             const auto eq = s.find('=');

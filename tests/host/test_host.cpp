@@ -245,7 +245,7 @@ TEST_P(Host, NoAllocationOrLockInsideProcessBlock)
         req.midi.push_back(msg(t + 0.09, {0xA0 | (k % 3), note, (k * 5) % 128}));
         req.midi.push_back(noteOff(t + 0.4 + 0.3 * (k % 4), note, k % 3));
         if (k % 16 == 0) req.midi.push_back(msg(t, {0xB0, 64, k % 32 == 0 ? 127 : 0}));
-        if (k % 8 == 0) req.midi.push_back(noteOn(t, 12 + (k / 8) % 6, 100)); // keyswitch: every articulation in turn
+        if (k % 8 == 0) req.midi.push_back(noteOn(t, 12 + (k / 8) % 7, 100)); // keyswitch: every articulation in turn
     }
     for (int b = 0; b * 256.0 / 48000.0 < 22.0; ++b) {
         const auto& id = params[static_cast<std::size_t>(b) % params.size()];
