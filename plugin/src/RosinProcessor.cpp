@@ -263,6 +263,10 @@ void RosinProcessor::loadMapping(const juce::String& name)
     map_.assign(m.entries);
     if (m.mpeGiven)
         if (auto* param = state_.getParameter("mpe")) param->setValueNotifyingHost(m.mpe ? 1.0f : 0.0f);
+    if (m.articulation >= 0)
+        if (auto* param = state_.getParameter("articulation")) param->setValueNotifyingHost(param->convertTo0to1(static_cast<float>(m.articulation)));
+    if (m.articulationChannels >= 0)
+        if (auto* param = state_.getParameter("articulation_channels")) param->setValueNotifyingHost(static_cast<float>(m.articulationChannels));
 }
 
 juce::String RosinProcessor::currentInstrument() const

@@ -312,3 +312,37 @@ TEST(Articulation, HarmonicsSoundAtTheHarmonicsPitch)
     EXPECT_EQ(string, 1); // the D string (G=0, D=1, A=2, E=3)
     EXPECT_EQ(s->chooseHarmonic(test::midiToHz(96), string), 4);
 }
+
+// On purpose, past Schelleng's limits: pressing hard with a slow bow (CC2 at the top, CC11 near
+// the bottom) does not give Helmholtz motion: the scratch a player can reach for.
+TEST(Articulation, PressingHardWithASlowBowScratches)
+{
+    const InstrumentPreset preset = loadInstrument(presetDir, "cello");
+    const auto& sp = preset.strings[2];
+    auto run = [&](int pressure, int expression) {
+        Synth s;
+        s.prepare(fs, preset, defaultParams());
+        std::vector<float> bridge(fs);
+        std::vector<std::uint8_t> stick(fs);
+        s.setVoiceTap(bridge.data(), stick.data(), fs);
+        midi(s, {0xB0, 2, pressure});
+        midi(s, {0xB0, 11, expression});
+        midi(s, {0x90, 50, 100});
+        play(s, 1.0);
+        lab::ClassifierInput in;
+        in.bridgeForce.assign(bridge.begin(), bridge.end());
+        in.sampleRate = fs;
+        in.f0 = sp.fundamental();
+        in.beta = defaultParams()[static_cast<int>(Param::BowPosition)];
+        in.z0 = sp.impedance();
+        in.tension = sp.tension;
+        in.length = sp.length;
+        const double a = defaultParams()[static_cast<int>(Param::AttackAccel)] * 100.0 / 127.0;
+        const double v = defaultParams()[static_cast<int>(Param::BowSpeed)] * 2.0 * expression / 127.0;
+        in.bowSpeed = [a, v](double t) { return std::min(v, a * t); };
+        in.stick.assign(stick.begin(), stick.end());
+        return lab::classify(in);
+    };
+    EXPECT_TRUE(run(64, 64).success);   // the nominal bow speaks
+    EXPECT_FALSE(run(127, 8).success);  // 2x the force at 1/8 of the speed: no Helmholtz
+}

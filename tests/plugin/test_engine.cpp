@@ -77,6 +77,8 @@ TEST(EnginePresets, EveryInstrumentLoadsWithItsFourStringsInPitchOrder)
     }
     EXPECT_NEAR(loadInstrument(presetDir, "double-bass").bowPosition, 0.13, 1e-9);
     EXPECT_EQ(listPresets(presetDir, "instruments").size(), 4u);
+    EXPECT_EQ(loadMapping(presetDir, "pizzicato").articulation, 5);
+    EXPECT_EQ(loadMapping(presetDir, "articulations-by-channel").articulationChannels, 1);
     EXPECT_EQ(loadExciter(presetDir, "enhanced-rod").contact, dsp::ContactLaw::PowerLaw);
     const MappingPreset keyboard = loadMapping(presetDir, "keyboard");
     ASSERT_EQ(keyboard.entries.size(), 4u);
@@ -109,6 +111,7 @@ TEST(EnginePresets, BadFilesNameTheFileAndTheField)
     expectError(R"({"format":"rosin-mapping/1","name":"m","mappings":[{"cc":7,"param":"bow_forse"}]})",
                 "mappings[0]: field 'param'", "mapping");
     expectError(R"({"format":"rosin-exciter/1","name":"e","friction_model":"magic"})", "field 'friction_model'", "exciter");
+    expectError(R"({"format":"rosin-mapping/1","name":"m","articulation":"glissando","mappings":[]})", "field 'articulation'", "mapping");
     EXPECT_THROW(loadInstrument(presetDir, "theremin"), std::runtime_error);
 }
 

@@ -66,6 +66,10 @@ TEST(Processor, MappingAndExciterPresetsSetWhatTheyName)
     EXPECT_FLOAT_EQ(p.parameters().getRawParameterValue("friction_model")->load(), 2.0f);
     EXPECT_FLOAT_EQ(p.parameters().getRawParameterValue("contact_law")->load(), 1.0f);
     EXPECT_THROW(p.loadMapping("no-such-map"), std::runtime_error);
+    p.loadMapping("pizzicato"); // articulation choices travel in map presets too
+    EXPECT_FLOAT_EQ(p.parameters().getRawParameterValue("articulation")->load(), 5.0f);
+    p.loadMapping("articulations-by-channel");
+    EXPECT_FLOAT_EQ(p.parameters().getRawParameterValue("articulation_channels")->load(), 1.0f);
 }
 
 TEST(Processor, LoadingAnInstrumentPresetSetsItsBowDefaults)

@@ -1,6 +1,7 @@
 #include "rosin/engine/Presets.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -187,6 +188,25 @@ MappingPreset loadMapping(const fs::path& presetDir, const std::string& nameOrPa
         if (!r.root["mpe"].is_boolean()) r.fail("field 'mpe' must be true or false");
         m.mpe = r.root["mpe"].get<bool>();
         m.mpeGiven = true;
+    }
+    if (r.root.contains("articulation")) {
+        const std::string a = r.text(r.root, "articulation", "");
+        const auto& info = paramInfo(Param::Articulation);
+        int index = 0;
+        std::string choices(info.choices), known;
+        for (std::size_t start = 0; start <= choices.size(); ++index) {
+            const std::size_t bar = std::min(choices.find('|', start), choices.size());
+            std::string name = choices.substr(start, bar - start);
+            std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+            if (name == a) m.articulation = index;
+            known += (known.empty() ? "" : ", ") + name;
+            start = bar + 1;
+        }
+        if (m.articulation < 0) r.fail("field 'articulation' is '" + a + "'; use one of: " + known);
+    }
+    if (r.root.contains("articulation_by_channel")) {
+        if (!r.root["articulation_by_channel"].is_boolean()) r.fail("field 'articulation_by_channel' must be true or false");
+        m.articulationChannels = r.root["articulation_by_channel"].get<bool>() ? 1 : 0;
     }
     if (!r.root.contains("mappings") || !r.root["mappings"].is_array()) r.fail("field 'mappings' must be an array");
     const json& list = r.root["mappings"];

@@ -48,6 +48,8 @@ struct MappingPreset {
     std::string name;
     bool mpe = false;
     bool mpeGiven = false;
+    int articulation = -1;         ///< articulation index the map selects, -1 = leave it
+    int articulationChannels = -1; ///< 1: MIDI channel n plays articulation n, 0 off, -1 leave it
     std::vector<MappingEntry> entries;
 };
 
