@@ -176,45 +176,35 @@ HidMapping HidMapping::defaultFor(DeviceKind kind)
     HidMapping m;
     m.kind = kind;
     m.name = kindName(kind);
+    if (kind != DeviceKind::Tablet) {
+        // Sticks, pucks and throttles hold their position: the axis is the speed, no pen to touch.
+        m.speed = Source::AxisX;
+        m.speedFromMotion = false;
+        m.positionCurve = {-1.0, 1.0, 0.03, 0.25};
+        m.stringSelect = Source::None;
+        m.requireTip = false;
+        m.tipNote = -1;
+        m.buttonNotes = {50, 57, -1, -1, -1, -1, -1, -1};
+    }
     switch (kind) {
     case DeviceKind::Tablet: break; // the struct defaults are the tablet (CONTROLLERS.md 5)
     case DeviceKind::Gamepad:
         m.force = Source::TriggerR;
         m.forceCurve = {0.0, 1.0, 0.0, 2.5, 1.5, 0.03};
-        m.speed = Source::AxisX;
-        m.speedFromMotion = false;
         m.position = Source::AxisY;
-        m.positionCurve = {-1.0, 1.0, 0.03, 0.25};
-        m.stringSelect = Source::None;
-        m.requireTip = false;
-        m.tipNote = -1;
         m.buttonNotes = {43, 50, 57, 64, -1, -1, -1, -1};
         break;
     case DeviceKind::SpaceMouse:
         m.force = Source::AxisZ;
         m.forceCurve = {-1.0, 0.0, 0.0, 2.5, 1.5, 0.05, true}; // push down (negative Z) = more force
-        m.speed = Source::AxisX;
-        m.speedFromMotion = false;
         m.position = Source::AxisY;
-        m.positionCurve = {-1.0, 1.0, 0.03, 0.25};
-        m.stringSelect = Source::None;
-        m.requireTip = false;
-        m.tipNote = -1;
-        m.buttonNotes = {50, 57, -1, -1, -1, -1, -1, -1};
         break;
     case DeviceKind::Joystick:
         m.force = Source::AxisY;
         m.forceCurve = {-1.0, 1.0, 0.0, 2.5, 1.5, 0.0, true}; // pull back = more force
-        m.speed = Source::AxisX;
-        m.speedFromMotion = false;
         m.position = Source::Slider;
-        m.positionCurve = {-1.0, 1.0, 0.03, 0.25};
-        m.stringSelect = Source::None;
-        m.requireTip = false;
-        m.tipNote = -1;
-        m.buttonNotes = {50, 57, -1, -1, -1, -1, -1, -1};
         break;
-    case DeviceKind::Other: m.force = Source::None; m.requireTip = false; m.tipNote = -1; break;
+    case DeviceKind::Other: m.force = Source::None; m.buttonNotes.fill(-1); break;
     }
     return m;
 }
