@@ -9,37 +9,10 @@ RosinEditor::RosinEditor(plugin::RosinProcessor& processor)
     : AudioProcessorEditor(processor), processor_(processor), generic_(processor)
 {
     addAndMakeVisible(generic_);
-    const auto dir = engine::presetDirectory();
-    int id = 1;
-    exciter_.setTextWhenNothingSelected("Exciter preset...");
-    for (const auto& name : engine::listPresets(dir, "exciters")) exciter_.addItem(name, id++);
-    exciter_.onChange = [this] {
-        try {
-            processor_.loadExciter(exciter_.getText());
-        } catch (const std::exception& e) {
-            status_.setText(e.what(), juce::dontSendNotification);
-        }
-    };
-    id = 1;
-    mapping_.setTextWhenNothingSelected("Controller map...");
-    for (const auto& name : engine::listPresets(dir, "mappings")) mapping_.addItem(name, id++);
-    mapping_.onChange = [this] {
-        try {
-            processor_.loadMapping(mapping_.getText());
-        } catch (const std::exception& e) {
-            status_.setText(e.what(), juce::dontSendNotification);
-        }
-    };
-    id = 1;
-    controller_.setTextWhenNothingSelected("HID controller map...");
-    for (const auto& name : engine::listPresets(dir, "controllers")) controller_.addItem(name, id++);
-    controller_.onChange = [this] {
-        try {
-            processor_.loadHidMapping(controller_.getText());
-        } catch (const std::exception& e) {
-            status_.setText(e.what(), juce::dontSendNotification);
-        }
-    };
+    addPresetPicker(exciter_, "exciters", "Exciter preset...", [this](const juce::String& n) { processor_.loadExciter(n); });
+    addPresetPicker(mapping_, "mappings", "Controller map...", [this](const juce::String& n) { processor_.loadMapping(n); });
+    addPresetPicker(controller_, "controllers", "HID controller map...",
+                    [this](const juce::String& n) { processor_.loadHidMapping(n); });
     learn_.setTextWhenNothingSelected("MIDI learn: pick a parameter, move a controller");
     for (int i = 0; i < engine::paramCount; ++i) {
         const auto& info = engine::paramInfo(i);
@@ -54,6 +27,21 @@ RosinEditor::RosinEditor(plugin::RosinProcessor& processor)
     setResizable(true, true);
     setSize(640, 720);
     startTimerHz(10);
+}
+
+void RosinEditor::addPresetPicker(juce::ComboBox& box, const std::string& kind, const juce::String& prompt,
+                                  std::function<void(const juce::String&)> load)
+{
+    box.setTextWhenNothingSelected(prompt);
+    int id = 1;
+    for (const auto& name : engine::listPresets(engine::presetDirectory(), kind)) box.addItem(name, id++);
+    box.onChange = [this, &box, load = std::move(load)] {
+        try {
+            load(box.getText());
+        } catch (const std::exception& e) { // a broken preset file: say which, keep playing
+            status_.setText(e.what(), juce::dontSendNotification);
+        }
+    };
 }
 
 void RosinEditor::paint(juce::Graphics& g) { g.fillAll(getLookAndFeel().findColour(juce::ResizableWindow::backgroundColourId)); }

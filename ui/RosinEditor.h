@@ -17,6 +17,8 @@ public:
 private:
     void timerCallback() override;
     void refreshMappings();
+    void addPresetPicker(juce::ComboBox& box, const std::string& kind, const juce::String& prompt,
+                         std::function<void(const juce::String&)> load);
 
     plugin::RosinProcessor& processor_;
     juce::GenericAudioProcessorEditor generic_;

@@ -171,6 +171,14 @@ void RosinProcessor::collectGarbage()
     while (trash_.pop(old)) delete old;
 }
 
+void RosinProcessor::setPhysical(engine::Param p, double value)
+{
+    // Host parameters hold choices as an index from 0; the engine's table counts from `min`.
+    const auto& info = paramInfo(p);
+    if (auto* param = state_.getParameter(juce::String(info.id.data(), info.id.size())))
+        param->setValueNotifyingHost(param->convertTo0to1(static_cast<float>(info.steps > 0 ? value - info.min : value)));
+}
+
 void RosinProcessor::pollHid()
 {
     const bool wanted = hidRaw_->load() > 0.5f;
@@ -218,16 +226,11 @@ void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults
     const int index = instrumentNames().indexOf(name);
     const auto preset = engine::loadInstrument(presetDir_.getFullPathName().toStdString(), name.toStdString());
     if (applyDefaults) {
-        auto set = [&](Param p, double value) {
-            const auto& info = paramInfo(p);
-            if (auto* param = state_.getParameter(juce::String(info.id.data(), info.id.size())))
-                param->setValueNotifyingHost(param->convertTo0to1(static_cast<float>(value)));
-        };
-        set(Param::BowForce, preset.bowForce);
-        set(Param::BowSpeed, preset.bowSpeed);
-        set(Param::BowPosition, preset.bowPosition);
-        set(Param::AttackAccel, preset.attackAccel);
-        set(Param::RosinTg, preset.rosinTg);
+        setPhysical(Param::BowForce, preset.bowForce);
+        setPhysical(Param::BowSpeed, preset.bowSpeed);
+        setPhysical(Param::BowPosition, preset.bowPosition);
+        setPhysical(Param::AttackAccel, preset.attackAccel);
+        setPhysical(Param::RosinTg, preset.rosinTg);
     }
     if (index >= 0) {
         if (auto* param = state_.getParameter(instrumentParamId))
@@ -246,27 +249,19 @@ void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults
 void RosinProcessor::loadExciter(const juce::String& name)
 {
     const auto e = engine::loadExciter(presetDir_.getFullPathName().toStdString(), name.toStdString());
-    auto set = [&](Param p, float value) {
-        const auto& info = paramInfo(p);
-        if (auto* param = state_.getParameter(juce::String(info.id.data(), info.id.size())))
-            param->setValueNotifyingHost(param->convertTo0to1(info.steps > 0 ? value - info.min : value));
-    };
-    set(Param::FrictionModel, static_cast<float>(static_cast<int>(e.model)));
-    set(Param::ContactLaw, e.contact == dsp::ContactLaw::PowerLaw ? 1.0f : 0.0f);
-    set(Param::Footprint, static_cast<float>(e.footprintRatio));
-    set(Param::Ambient, static_cast<float>(e.ambient));
+    setPhysical(Param::FrictionModel, static_cast<int>(e.model));
+    setPhysical(Param::ContactLaw, e.contact == dsp::ContactLaw::PowerLaw ? 1.0 : 0.0);
+    setPhysical(Param::Footprint, e.footprintRatio);
+    setPhysical(Param::Ambient, e.ambient);
 }
 
 void RosinProcessor::loadMapping(const juce::String& name)
 {
     const auto m = engine::loadMapping(presetDir_.getFullPathName().toStdString(), name.toStdString());
     map_.assign(m.entries);
-    if (m.mpeGiven)
-        if (auto* param = state_.getParameter("mpe")) param->setValueNotifyingHost(m.mpe ? 1.0f : 0.0f);
-    if (m.articulation >= 0)
-        if (auto* param = state_.getParameter("articulation")) param->setValueNotifyingHost(param->convertTo0to1(static_cast<float>(m.articulation)));
-    if (m.articulationChannels >= 0)
-        if (auto* param = state_.getParameter("articulation_channels")) param->setValueNotifyingHost(static_cast<float>(m.articulationChannels));
+    if (m.mpeGiven) setPhysical(Param::Mpe, m.mpe ? 1.0 : 0.0);
+    if (m.articulation >= 0) setPhysical(Param::Articulation, m.articulation);
+    if (m.articulationChannels >= 0) setPhysical(Param::ArticulationChannels, m.articulationChannels);
 }
 
 juce::String RosinProcessor::currentInstrument() const

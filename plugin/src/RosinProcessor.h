@@ -76,6 +76,7 @@ private:
     std::unique_ptr<engine::Synth> buildSynth(const engine::InstrumentPreset& preset, double sampleRate, int tag);
     void handOver(std::unique_ptr<engine::Synth> synth);
     void collectGarbage();
+    void setPhysical(engine::Param p, double value); ///< [not audio] a parameter by its value in the engine's units
     void pollHid(); ///< [loader thread] start or stop the HID input with its parameter
     void drainHid(engine::Synth& synth) noexcept;
     engine::ParamValues currentParams() const;

@@ -45,6 +45,24 @@ std::vector<float> play(Synth& s, double seconds, const std::function<void()>& w
     return m;
 }
 
+/// The lab's classifier (PHYSICS.md 6.5) on a voice's tapped bridge force: a Guettler ramp at
+/// `accel` up to `speed`, on string `sp` bowed at `beta`.
+lab::Classification classifyVoice(const std::vector<float>& bridge, const std::vector<std::uint8_t>& stick,
+                                  const dsp::StringParams& sp, double beta, double accel, double speed)
+{
+    lab::ClassifierInput in;
+    in.bridgeForce.assign(bridge.begin(), bridge.end());
+    in.sampleRate = fs;
+    in.f0 = sp.fundamental();
+    in.beta = beta;
+    in.z0 = sp.impedance();
+    in.tension = sp.tension;
+    in.length = sp.length;
+    in.bowSpeed = [accel, speed](double t) { return std::min(speed, accel * t); };
+    in.stick.assign(stick.begin(), stick.end());
+    return lab::classify(in);
+}
+
 ParamValues with(std::initializer_list<std::pair<Param, float>> values)
 {
     ParamValues p = defaultParams();
@@ -269,18 +287,8 @@ TEST(Articulation, DefaultVelocityReachesHelmholtzOnEveryString)
             s.setVoiceTap(bridge.data(), stick.data(), fs);
             midi(s, {0x90, note, 100}); // a keyboard's default velocity
             play(s, 1.0);
-            lab::ClassifierInput in;
-            in.bridgeForce.assign(bridge.begin(), bridge.end());
-            in.sampleRate = fs;
-            in.f0 = sp.fundamental();
-            in.beta = preset.bowPosition;
-            in.z0 = sp.impedance();
-            in.tension = sp.tension;
-            in.length = sp.length;
-            const double a = preset.attackAccel * 100.0 / 127.0, v = preset.bowSpeed;
-            in.bowSpeed = [a, v](double t) { return std::min(v, a * t); };
-            in.stick.assign(stick.begin(), stick.end());
-            const lab::Classification c = lab::classify(in);
+            const lab::Classification c =
+                classifyVoice(bridge, stick, sp, preset.bowPosition, preset.attackAccel * 100.0 / 127.0, preset.bowSpeed);
             EXPECT_TRUE(c.success) << name << " string " << string << ": " << c.labels;
             EXPECT_LE(c.transientPeriods, 20) << name << " string " << string;
         }
@@ -329,19 +337,10 @@ TEST(Articulation, PressingHardWithASlowBowScratches)
         midi(s, {0xB0, 11, expression});
         midi(s, {0x90, 50, 100});
         play(s, 1.0);
-        lab::ClassifierInput in;
-        in.bridgeForce.assign(bridge.begin(), bridge.end());
-        in.sampleRate = fs;
-        in.f0 = sp.fundamental();
-        in.beta = defaultParams()[static_cast<int>(Param::BowPosition)];
-        in.z0 = sp.impedance();
-        in.tension = sp.tension;
-        in.length = sp.length;
-        const double a = defaultParams()[static_cast<int>(Param::AttackAccel)] * 100.0 / 127.0;
-        const double v = defaultParams()[static_cast<int>(Param::BowSpeed)] * 2.0 * expression / 127.0;
-        in.bowSpeed = [a, v](double t) { return std::min(v, a * t); };
-        in.stick.assign(stick.begin(), stick.end());
-        return lab::classify(in);
+        const ParamValues d = defaultParams();
+        return classifyVoice(bridge, stick, sp, d[static_cast<int>(Param::BowPosition)],
+                             d[static_cast<int>(Param::AttackAccel)] * 100.0 / 127.0,
+                             d[static_cast<int>(Param::BowSpeed)] * 2.0 * expression / 127.0);
     };
     EXPECT_TRUE(run(64, 64).success);   // the nominal bow speaks
     EXPECT_FALSE(run(127, 8).success);  // 2x the force at 1/8 of the speed: no Helmholtz

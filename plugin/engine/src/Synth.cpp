@@ -129,14 +129,28 @@ double Synth::noteFrequency(double midiNote) const noexcept
     return instrument_.tuningA4 * std::exp2((midiNote - 69.0) / 12.0);
 }
 
+bool Synth::reaches(int s, double frequency) const noexcept
+{
+    if (s < 0 || s >= instrument_.stringCount) return false;
+    const double open = instrument_.strings[static_cast<std::size_t>(s)].fundamental();
+    // A quarter-tone flat still counts as this string; the top is the highest stop.
+    return frequency >= open * std::exp2(-0.5 / 12.0) && frequency <= open * std::exp2(instrument_.maxStopSemitones / 12.0);
+}
+
+void Synth::glideTo(Voice& v, int note) noexcept
+{
+    v.note = note;
+    v.glideTarget = note;
+    const double time = params_[static_cast<int>(Param::Portamento)];
+    v.glideStep = time > 0.0 ? std::abs(v.glideTarget - v.pitch) * controlInterval / (time * fs_) : 1e9;
+}
+
 int Synth::chooseString(double frequency, int preferred, unsigned occupiedMask) const noexcept
 {
     const int n = instrument_.stringCount;
     if (n <= 0) return 0;
-    const double top = std::exp2(instrument_.maxStopSemitones / 12.0);
-    const double flat = std::exp2(-0.5 / 12.0); // a quarter-tone flat still counts as this string
     auto open = [&](int s) { return instrument_.strings[static_cast<std::size_t>(s)].fundamental(); };
-    auto reachable = [&](int s) { return s >= 0 && s < n && frequency >= open(s) * flat && frequency <= open(s) * top; };
+    auto reachable = [&](int s) { return reaches(s, frequency); };
     if (external_.active && reachable(external_.string)) return external_.string; // the controller picked it
     const auto policy = static_cast<StringPolicy>(static_cast<int>(params_[static_cast<int>(Param::StringPolicy)]));
     if (policy == StringPolicy::StayOnString && reachable(preferred)) return preferred;
@@ -365,15 +379,10 @@ void Synth::noteOn(int ch, int note, int velocity) noexcept
         // A held note on this channel hands its bow over: glide on its string if it reaches.
         for (auto& v : voices_) {
             if (!v.active || v.channel != ch || !v.keyDown || v.released) continue;
-            const double open = instrument_.strings[static_cast<std::size_t>(v.stringIndex)].fundamental();
-            const double top = open * std::exp2(instrument_.maxStopSemitones / 12.0);
-            if (f >= open * std::exp2(-0.5 / 12.0) && f <= top) {
+            if (reaches(v.stringIndex, f)) {
                 if (v.heldCount < static_cast<int>(v.held.size())) v.held[static_cast<std::size_t>(v.heldCount++)] = note;
                 else v.held.back() = note;
-                v.note = note;
-                v.glideTarget = note;
-                const double time = params_[static_cast<int>(Param::Portamento)];
-                v.glideStep = time > 0.0 ? std::abs(v.glideTarget - v.pitch) * controlInterval / (time * fs_) : 1e9;
+                glideTo(v, note);
                 v.polyPressure = -1.0f;
                 return;
             }
@@ -470,12 +479,7 @@ void Synth::noteOff(int ch, int note) noexcept
         --v.heldCount;
         if (v.heldCount > 0) { // legato: back to the note still held
             const int back = v.held[static_cast<std::size_t>(v.heldCount - 1)];
-            if (back != v.note) {
-                v.note = back;
-                v.glideTarget = back;
-                const double time = params_[static_cast<int>(Param::Portamento)];
-                v.glideStep = time > 0.0 ? std::abs(v.glideTarget - v.pitch) * controlInterval / (time * fs_) : 1e9;
-            }
+            if (back != v.note) glideTo(v, back);
             continue;
         }
         v.keyDown = false;

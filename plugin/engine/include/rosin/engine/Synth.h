@@ -142,6 +142,8 @@ private:
     void startVoice(Voice& v, int channel, int note, int velocity, int stringIndex) noexcept;
     void updateControl(Voice& v) noexcept;
     void renderVoice(Voice& v, float* busL, float* busR, int n) noexcept;
+    bool reaches(int string, double frequency) const noexcept; ///< open pitch (a quarter-tone flat) up to the highest stop
+    void glideTo(Voice& v, int note) noexcept;                  ///< legato: the finger moves over `portamento`
     void listen(Voice& v, bool stick) noexcept;
     void applyFriction() noexcept;
     Voice* findVoiceToStart() noexcept;
