@@ -363,3 +363,62 @@ TEST(EngineExternalBow, AControllerBowReplacesTheNominalAndMayReverse)
     s->setExternalBow(bow);
     EXPECT_TRUE(std::isfinite(s->externalBow().force) && std::isfinite(s->externalBow().speed));
 }
+
+// The editor's live views: the newest note writes its physics, sample by sample, into the ring
+// while someone listens; nobody listening costs no frames; a full ring drops, never blocks.
+TEST(EngineViewTap, TheNewestNoteWritesItsPhysicsWhileSomeoneListens)
+{
+    auto s = makeSynth("cello");
+    ViewRing ring(1u << 16);
+    s->setViewTap(&ring);
+    render(*s, 4800, {on(0, 50)});
+    std::vector<ViewFrame> frames(ring.capacity());
+    EXPECT_EQ(ring.read(frames.data(), frames.size()), 0u) << "no listener, no frames";
+
+    ring.setListening(true);
+    const int n = 24000;
+    render(*s, n, {on(0, 57)}); // a second note (A3, the open A string): the views follow it
+    const std::size_t got = ring.read(frames.data(), frames.size());
+    ASSERT_EQ(got, static_cast<std::size_t>(n));
+    EXPECT_EQ(frames[0].noteStart, 1);
+    EXPECT_EQ(frames[1].noteStart, 0);
+    const double expected = 440.0 * std::exp2((57 - 69) / 12.0);
+    EXPECT_NEAR(frames[n - 1].frequency, expected, expected * 0.01);
+    // Helmholtz motion on the bowed note: sticking at the bow speed, slipping once a period.
+    int onsets = 0;
+    double stickMismatch = 0.0;
+    for (int i = n / 2; i < n; ++i) {
+        const auto& f = frames[static_cast<std::size_t>(i)];
+        if (!f.stick && frames[static_cast<std::size_t>(i - 1)].stick) ++onsets;
+        if (f.stick) stickMismatch = std::max(stickMismatch, std::abs(static_cast<double>(f.velocity - f.bowSpeed)));
+        EXPECT_GT(f.force, 0.0f);
+        EXPECT_TRUE(std::isfinite(f.temperature));
+    }
+    const double periods = (n / 2) / 48000.0 * expected;
+    EXPECT_NEAR(onsets / periods, 1.0, 0.1);
+    EXPECT_LT(stickMismatch, 1e-3);
+
+    // The ring full and unread: the audio keeps running, frames are counted as dropped.
+    render(*s, static_cast<int>(ring.capacity()) + 4800, {});
+    EXPECT_GE(ring.dropped(), 4800u);
+    EXPECT_EQ(ring.read(frames.data(), frames.size()), ring.capacity());
+}
+
+TEST(EngineViewTap, WhenTheWatchedNoteEndsTheViewsFollowOneStillSounding)
+{
+    auto s = makeSynth("violin");
+    ViewRing ring(1u << 17);
+    ring.setListening(true);
+    s->setViewTap(&ring);
+    // G3 held, D5 played and released: after D5 dies the views return to the G.
+    render(*s, 96000, {on(0, 55), on(4800, 74), off(24000, 74)});
+    std::vector<ViewFrame> frames(ring.capacity());
+    const std::size_t got = ring.read(frames.data(), frames.size());
+    ASSERT_GT(got, 90000u);
+    EXPECT_NEAR(frames[100].frequency, 196.0, 3.0);
+    EXPECT_NEAR(frames[10000].frequency, 587.3, 6.0);
+    EXPECT_NEAR(frames[got - 1].frequency, 196.0, 3.0);
+    int starts = 0;
+    for (std::size_t i = 0; i < got; ++i) starts += frames[i].noteStart;
+    EXPECT_EQ(starts, 3); // G, D, back to G
+}

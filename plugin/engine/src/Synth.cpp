@@ -30,6 +30,22 @@ double onePole(double seconds, double fs) { return 1.0 - std::exp(-1.0 / (second
 double dbToGain(double db) { return std::pow(10.0, db / 20.0); }
 } // namespace
 
+dsp::BowedStringConfig stringConfig(const InstrumentPreset& instrument, int s, const ParamValues& params)
+{
+    const auto p = [&](Param q) { return sanitise(q, params[static_cast<std::size_t>(q)]); };
+    dsp::BowedStringConfig c;
+    c.string = instrument.strings[static_cast<std::size_t>(std::clamp(s, 0, std::max(0, instrument.stringCount - 1)))];
+    c.waveguide.lowestPitchRatio = 0.5; // an octave of bend below the open string
+    c.waveguide.dispersion = false;     // the allpass fit is not redone per stop
+    c.friction.switchable = true;
+    c.friction.model = static_cast<dsp::FrictionModel>(static_cast<int>(p(Param::FrictionModel)));
+    c.friction.contactLaw = p(Param::ContactLaw) > 0.5f ? dsp::ContactLaw::PowerLaw : dsp::ContactLaw::Amontons;
+    c.friction.thermal.glassTransitionCelsius = p(Param::RosinTg);
+    c.friction.thermal.ambientCelsius = p(Param::Ambient);
+    c.friction.thermal.footprintRatio = p(Param::Footprint);
+    return c;
+}
+
 void Synth::prepare(double sampleRate, const InstrumentPreset& instrument, const ParamValues& params, ControllerMap* map)
 {
     fs_ = sampleRate;
@@ -40,19 +56,7 @@ void Synth::prepare(double sampleRate, const InstrumentPreset& instrument, const
     // One prepared string per instrument string, copied into every voice: the temperature
     // tables are built once per string, not once per voice.
     std::array<dsp::BowedString<float>, maxStrings> templates;
-    for (int s = 0; s < instrument.stringCount; ++s) {
-        dsp::BowedStringConfig c;
-        c.string = instrument.strings[static_cast<std::size_t>(s)];
-        c.waveguide.lowestPitchRatio = 0.5; // an octave of bend below the open string
-        c.waveguide.dispersion = false;     // the allpass fit is not redone per stop
-        c.friction.switchable = true;
-        c.friction.model = static_cast<dsp::FrictionModel>(static_cast<int>(params_[static_cast<int>(Param::FrictionModel)]));
-        c.friction.contactLaw = params_[static_cast<int>(Param::ContactLaw)] > 0.5f ? dsp::ContactLaw::PowerLaw : dsp::ContactLaw::Amontons;
-        c.friction.thermal.glassTransitionCelsius = params_[static_cast<int>(Param::RosinTg)];
-        c.friction.thermal.ambientCelsius = params_[static_cast<int>(Param::Ambient)];
-        c.friction.thermal.footprintRatio = params_[static_cast<int>(Param::Footprint)];
-        templates[static_cast<std::size_t>(s)].prepare(sampleRate, c);
-    }
+    for (int s = 0; s < instrument.stringCount; ++s) templates[static_cast<std::size_t>(s)].prepare(sampleRate, stringConfig(instrument, s, params_));
     for (auto& v : voices_)
         for (int s = 0; s < instrument.stringCount; ++s) v.strings[static_cast<std::size_t>(s)] = templates[static_cast<std::size_t>(s)];
 
@@ -74,6 +78,7 @@ void Synth::prepare(double sampleRate, const InstrumentPreset& instrument, const
 
 void Synth::reset() noexcept
 {
+    watched_ = nullptr;
     for (auto& v : voices_) {
         v.active = false;
         for (int s = 0; s < instrument_.stringCount; ++s) v.strings[static_cast<std::size_t>(s)].reset();
@@ -451,6 +456,8 @@ void Synth::startVoice(Voice& v, int ch, int note, int velocity, int s) noexcept
     v.fade = 1.0;
     v.age = 0.0;
     v.peak = 0.0;
+    watched_ = &v; // the views follow the newest note
+    watchedIsNew_ = true;
     if (tapArmed_) {
         tapArmed_ = false;
         tapVoice_ = &v;
@@ -612,6 +619,8 @@ void Synth::renderVoice(Voice& v, float* busL, float* busR, int n) noexcept
     const float gl = v.gainL * v.volume * v.volume, gr = v.gainR * v.volume * v.volume;
     float theta = v.lastTemperature;
     const bool tapped = tapVoice_ == &v;
+    const bool watched = viewRing_ != nullptr && watched_ == &v && viewRing_->listening();
+    int viewed = 0;
     for (int i = 0; i < n; ++i) {
         if (v.untilControl-- <= 0) {
             updateControl(v);
@@ -651,6 +660,22 @@ void Synth::renderVoice(Voice& v, float* busL, float* busR, int n) noexcept
             if (tapStick_) tapStick_[tapCount_] = frame.stick ? 1 : 0;
             ++tapCount_;
         }
+        if (watched) {
+            ViewFrame& f = viewChunk_[static_cast<std::size_t>(viewed++)];
+            f.bridgeForce = y;
+            f.velocity = frame.velocity;
+            f.bowSpeed = static_cast<float>(v.speed);
+            f.friction = frame.friction;
+            f.force = pluck != 0.0 ? 0.0f : static_cast<float>(v.force * v.lift);
+            f.temperature = frame.temperature;
+            f.beta = static_cast<float>(v.beta);
+            f.frequency = static_cast<float>(v.frequency);
+            f.stick = frame.stick ? 1 : 0;
+            f.string = static_cast<std::uint8_t>(v.stringIndex);
+            f.noteStart = watchedIsNew_ ? 1 : 0;
+            f.bowed = pluck != 0.0 ? 0 : 1;
+            watchedIsNew_ = false;
+        }
         const float out = static_cast<float>(y * v.fade);
         busL[i] += gl * out;
         busR[i] += gr * out;
@@ -663,6 +688,7 @@ void Synth::renderVoice(Voice& v, float* busL, float* busR, int n) noexcept
             break;
         }
     }
+    if (viewed > 0) viewRing_->write(viewChunk_.data(), static_cast<std::size_t>(viewed));
     v.lastTemperature = theta;
 }
 
@@ -700,6 +726,7 @@ void Synth::render(float* left, float* right, int numSamples) noexcept
         const int n = std::min(chunk, numSamples - start);
         std::fill_n(busL_.data(), n, 0.0f);
         std::fill_n(busR_.data(), n, 0.0f);
+        if (viewRing_ != nullptr && (watched_ == nullptr || !watched_->active)) chooseWatched();
         for (auto& v : voices_)
             if (v.active) renderVoice(v, busL_.data(), busR_.data(), n);
         for (int i = 0; i < n; ++i) {
@@ -716,6 +743,16 @@ void Synth::render(float* left, float* right, int numSamples) noexcept
             right[start + i] = std::clamp(outR, -4.0f, 4.0f);
         }
     }
+}
+
+void Synth::chooseWatched() noexcept
+{
+    // The watched note ended: follow the newest one still sounding.
+    const Voice* best = nullptr;
+    for (const auto& v : voices_)
+        if (v.active && (best == nullptr || v.order > best->order)) best = &v;
+    if (best != watched_) watchedIsNew_ = best != nullptr;
+    watched_ = best;
 }
 
 int Synth::activeVoiceCount() const noexcept

@@ -15,6 +15,7 @@
 #include "rosin/engine/ControllerMap.h"
 #include "rosin/engine/Parameters.h"
 #include "rosin/engine/Presets.h"
+#include "rosin/engine/ViewTap.h"
 
 namespace rosin::engine {
 
@@ -30,6 +31,10 @@ struct ExternalBow {
 };
 
 /// What a test or an editor may want to know about a voice.
+/// How the engine configures string `s` of an instrument for these parameters (model, contact,
+/// rosin, ambient, footprint): the voices and the editor's playability map use the same one.
+dsp::BowedStringConfig stringConfig(const InstrumentPreset& instrument, int s, const ParamValues& params);
+
 struct VoiceInfo {
     bool active = false;
     int channel = -1, note = -1, stringIndex = -1;
@@ -90,6 +95,9 @@ public:
     /// and stick flags into these caller-owned buffers, up to `capacity` samples.
     void setVoiceTap(float* bridgeForce, std::uint8_t* stick, int capacity) noexcept;
     int voiceTapCount() const noexcept { return tapCount_; }
+    /// Live views: the newest sounding voice writes one ViewFrame per sample into `ring` while
+    /// the ring has a listener (nullptr stops it). The ring outlives this engine.
+    void setViewTap(ViewRing* ring) noexcept { viewRing_ = ring; }
     /// Lowest MIDI note that is a keyswitch (C0); articulation n is this note + n.
     static constexpr int keyswitchBase = 12;
     double noteFrequency(double midiNote) const noexcept;
@@ -174,6 +182,11 @@ private:
     int tapCapacity_ = 0, tapCount_ = 0;
     const Voice* tapVoice_ = nullptr;
     bool tapArmed_ = false;
+    ViewRing* viewRing_ = nullptr;
+    const Voice* watched_ = nullptr;
+    bool watchedIsNew_ = false;
+    std::array<ViewFrame, chunk> viewChunk_{};
+    void chooseWatched() noexcept;
     void applyBody() noexcept;
 };
 
