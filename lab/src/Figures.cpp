@@ -10,28 +10,6 @@
 
 namespace rosin::lab {
 
-Color transientColor(int periods)
-{
-    // Light = short, dark = long (PHYSICS.md 6.6): cream -> amber -> olive -> dark teal.
-    static const Color stops[] = {{1.0, 0.98, 0.82}, {0.99, 0.76, 0.3}, {0.62, 0.72, 0.3}, {0.12, 0.36, 0.32}};
-    const double x = std::clamp(periods / 25.0, 0.0, 1.0) * 3.0;
-    const int i = std::min(2, static_cast<int>(x));
-    const double s = x - i;
-    const Color a = stops[i], b = stops[i + 1];
-    return {a.r + s * (b.r - a.r), a.g + s * (b.g - a.g), a.b + s * (b.b - a.b)};
-}
-
-Color regimeColor(Regime r)
-{
-    switch (r) {
-    case Regime::DoubleSlip: return colors::blue;
-    case Regime::DoubleFlyback: return colors::cyan;
-    case Regime::Irregular: return colors::red;
-    case Regime::NoSlip: return colors::black;
-    default: return colors::white;
-    }
-}
-
 void drawGuettler(Canvas& canvas, double left, double top, double width, double height, const SweepResult& r,
                   std::size_t ib, const DiagramOptions& o)
 {

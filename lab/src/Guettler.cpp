@@ -332,18 +332,4 @@ BoundaryFit fitLowerBoundary(const SweepResult& r, std::size_t ib)
     return fit;
 }
 
-GuettlerBounds guettlerBounds(const dsp::StringParams& s, double beta, double muS, double muD)
-{
-    const double P0Z0 = s.impedance() / s.fundamental();
-    const double k = beta * (1.0 - beta) / P0Z0;
-    const double c1 = 3.0 * muS - muD - 2.0 * std::sqrt(2.0 * muS * muS - muS * muD);
-    const double c2 = ((3.0 - 4.0 * beta) * muS - muD
-                       - 2.0 * std::sqrt((1.0 - 2.0 * beta) * (2.0 * (1.0 - beta) * muS * muS - muS * muD)))
-                      / (1.0 - 2.0 * beta);
-    GuettlerBounds b;
-    b.upperPerAccel = 1.0 / (k * c1);
-    b.lowerPerAccel = 1.0 / (k * c2);
-    return b;
-}
-
 } // namespace rosin::lab

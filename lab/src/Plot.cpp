@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "rosin/lab/Error.h"
+#include "rosin/lab/Views.h" // niceTicks
 
 namespace rosin::lab {
 
@@ -47,19 +48,77 @@ void Canvas::save(const std::filesystem::path& file) const
         throw LabError(file.string() + ": cannot write PNG");
 }
 
-std::vector<double> niceTicks(double lo, double hi, int target)
+void CairoPainter::fillRect(const Rect& r, Color c)
 {
-    std::vector<double> ticks;
-    const double span = hi - lo;
-    if (!(span > 0)) return {lo};
-    const double raw = span / target, mag = std::pow(10.0, std::floor(std::log10(raw)));
-    double step = mag;
-    for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
-        if (m * mag >= raw) { step = m * mag; break; }
-    for (double t = std::ceil(lo / step - 1e-9) * step; t <= hi + 1e-9 * span; t += step)
-        ticks.push_back(std::abs(t) < 1e-12 * step ? 0.0 : t);
-    return ticks;
+    cairo_t* cr = canvas_.context();
+    cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a);
+    cairo_rectangle(cr, r.x, r.y, r.w, r.h);
+    cairo_fill(cr);
 }
+
+void CairoPainter::strokeRect(const Rect& r, Color c, double width)
+{
+    cairo_t* cr = canvas_.context();
+    cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a);
+    cairo_set_line_width(cr, width);
+    cairo_rectangle(cr, r.x, r.y, r.w, r.h);
+    cairo_stroke(cr);
+}
+
+void CairoPainter::line(double x0, double y0, double x1, double y1, Color c, double width, bool dashed)
+{
+    cairo_t* cr = canvas_.context();
+    cairo_save(cr);
+    if (dashed) {
+        const double dash[] = {5.0, 4.0};
+        cairo_set_dash(cr, dash, 2, 0.0);
+    }
+    cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a);
+    cairo_set_line_width(cr, width);
+    cairo_move_to(cr, x0, y0);
+    cairo_line_to(cr, x1, y1);
+    cairo_stroke(cr);
+    cairo_restore(cr);
+}
+
+void CairoPainter::polyline(const std::vector<double>& x, const std::vector<double>& y, Color c, double width)
+{
+    const std::size_t n = std::min(x.size(), y.size());
+    if (n < 2) return;
+    cairo_t* cr = canvas_.context();
+    cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a);
+    cairo_set_line_width(cr, width);
+    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+    cairo_move_to(cr, x[0], y[0]);
+    for (std::size_t i = 1; i < n; ++i) cairo_line_to(cr, x[i], y[i]);
+    cairo_stroke(cr);
+}
+
+void CairoPainter::fillCircle(double cx, double cy, double radius, Color c)
+{
+    cairo_t* cr = canvas_.context();
+    cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a);
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, cx, cy, radius, 0.0, 2.0 * 3.14159265358979);
+    cairo_fill(cr);
+}
+
+void CairoPainter::text(const Rect& box, const std::string& s, double size, Color c, Align align, bool bold)
+{
+    const double alignX = align == Align::Left ? 0.0 : align == Align::Centre ? 0.5 : 1.0;
+    const double x = align == Align::Left ? box.x : align == Align::Centre ? box.x + box.w / 2 : box.right();
+    canvas_.text(x, box.y + box.h / 2, s, size, c, alignX, 0.35, 0.0, bold);
+}
+
+void CairoPainter::pushClip(const Rect& r)
+{
+    cairo_t* cr = canvas_.context();
+    cairo_save(cr);
+    cairo_rectangle(cr, r.x, r.y, r.w, r.h);
+    cairo_clip(cr);
+}
+
+void CairoPainter::popClip() { cairo_restore(canvas_.context()); }
 
 Axes::Axes(Canvas& canvas, double left, double top, double width, double height, double xMin, double xMax, double yMin,
            double yMax, bool logX)

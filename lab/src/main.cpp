@@ -23,7 +23,8 @@ int main(int argc, char** argv)
 
     const std::vector<Command> commands{addRenderCommand(app),   addStringsCommand(app),  addBenchCommand(app),
                                         addGuettlerCommand(app), addPanelCommand(app),    addClassifyCommand(app),
-                                        addDiagnoseCommand(app), addSynthDataCommand(app), addFiguresCommand(app)};
+                                        addDiagnoseCommand(app), addSynthDataCommand(app), addFiguresCommand(app),
+                                        addPlayabilityCommand(app)};
 
     if (argc > 1 && argv[1][0] != '-') {
         bool known = false;

@@ -164,5 +164,6 @@ Command addClassifyCommand(CLI::App& app);
 Command addDiagnoseCommand(CLI::App& app);
 Command addSynthDataCommand(CLI::App& app);
 Command addFiguresCommand(CLI::App& app);
+Command addPlayabilityCommand(CLI::App& app);
 
 } // namespace rosin::cli

@@ -25,13 +25,14 @@
 #include "rosin/lab/Render.h"
 #include "rosin/lab/Signal.h"
 #include "rosin/lab/SynthData.h"
+#include "rosin/lab/ViewFigures.h"
 
 namespace rosin::cli {
 
 namespace {
 
 int runRender(const ModelOptions& m, const std::string& gestureName, const Gesture& g0, const std::string& gestureFile,
-              double duration, double sampleRate, const std::string& out, bool noCsv, bool listen, bool quiet)
+              double duration, double sampleRate, const std::string& out, bool noCsv, bool listen, bool quiet, bool views)
 {
     RenderSpec spec;
     spec.config = m.build();
@@ -48,6 +49,8 @@ int runRender(const ModelOptions& m, const std::string& gestureName, const Gestu
     const fs::path wavPath = out + ".wav", csvPath = out + ".csv";
     const fs::path wavTmp = outputs.add(wavPath);
     const fs::path csvTmp = noCsv ? fs::path() : outputs.add(csvPath);
+    const fs::path viewsPng = views ? outputs.add(out + "-views.png") : fs::path();
+    const fs::path viewsJson = views ? outputs.add(out + "-views.json") : fs::path();
 
     Progress progress("rendering", !quiet);
     const RenderResult result = render(spec, [&](double x) { progress.update(x); });
@@ -57,6 +60,16 @@ int runRender(const ModelOptions& m, const std::string& gestureName, const Gestu
     for (std::size_t i = 0; i < bridge.size(); ++i) bridge[i] = result.frames[i].bridgeForce;
     writeWav(wavTmp, bridge, result.sampleRate, listen ? WavEncoding::Pcm24Normalized : WavEncoding::Float32);
     if (!noCsv) writeRenderCsv(csvTmp, result);
+    if (views) {
+        // The plugin window's views at the end of this stroke, over a Schelleng map of the string.
+        const LiveHistory h = historyOf(result, spec.config.string.fundamental());
+        const auto g = h.gesture();
+        PlayabilitySpec ps = PlayabilitySpec::around(MapKind::Schelleng, spec.config, std::max(0.05, g.force),
+                                                     std::max(0.02, std::abs(g.speed)), g.beta, 1.0, 0.0, 14, 12);
+        ps.sampleRate = std::min(spec.sampleRate, 96000.0);
+        const PlayabilityMap map = computePlayability(ps);
+        writeLiveViews(viewsPng, viewsJson, h, &map, spec.config.string.name + ", " + m.model + " model");
+    }
     outputs.commit();
 
     if (!quiet) {
@@ -72,6 +85,7 @@ int runRender(const ModelOptions& m, const std::string& gestureName, const Gestu
         std::printf("peak bridge force %.3f N, peak contact rise %.1f K, slipping %.1f %% of the time\n",
                     s.peakBridgeForce, s.peakTemperatureRise, 100.0 * s.slipFraction);
         std::printf("wrote %s%s%s\n", wavPath.c_str(), noCsv ? "" : " and ", noCsv ? "" : csvPath.c_str());
+        if (views) std::printf("wrote %s-views.png and %s-views.json\n", out.c_str(), out.c_str());
     }
     return 0;
 }
@@ -126,7 +140,7 @@ struct RenderCommand {
     std::string gestureName = "guettler", gestureFile, out = "rosin-render";
     Gesture gesture;
     double duration = 0.0, sampleRate = 192000.0;
-    bool noCsv = false, listen = false, quiet = false;
+    bool noCsv = false, listen = false, quiet = false, views = false;
     std::string midi, preset = "cello", plugin;
     CLI::Option* rateOption = nullptr;
 
@@ -170,6 +184,8 @@ struct RenderCommand {
             ->capture_default_str();
         renderCmd->add_option("-o,--out", out, "Output path prefix: writes OUT.wav and OUT.csv")->capture_default_str();
         renderCmd->add_flag("--no-csv", noCsv, "Write only the WAV");
+        renderCmd->add_flag("--views", views, "Also draw the plugin window's live views at the stroke's end (scope, "
+                                              "temperature, friction loop, Schelleng map) to OUT-views.png, data in OUT-views.json");
         renderCmd->add_flag("--listen", listen, "Normalised 24-bit WAV for listening instead of newtons");
         renderCmd->add_flag("-q,--quiet", quiet, "No progress and no summary");
         renderCmd->add_option("--midi", midi, "Play this MIDI file on the instrument (plugin) instead of one gesture");
@@ -184,7 +200,7 @@ struct RenderCommand {
     {
         // Music defaults to 48 kHz; the 192 kHz research default is for single gestures.
         if (!midi.empty()) return runMidiRender(midi, preset, plugin, rateOption->count() ? sampleRate : 48000.0, out, quiet);
-        return runRender(renderModel, gestureName, gesture, gestureFile, duration, sampleRate, out, noCsv, listen, quiet);
+        return runRender(renderModel, gestureName, gesture, gestureFile, duration, sampleRate, out, noCsv, listen, quiet, views);
     }
 };
 

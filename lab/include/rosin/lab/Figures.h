@@ -7,6 +7,7 @@
 
 #include "rosin/lab/Guettler.h"
 #include "rosin/lab/Plot.h"
+#include "rosin/lab/Views.h" // transientColor, regimeColor
 
 namespace rosin::lab {
 
@@ -17,8 +18,6 @@ struct DiagramOptions {
     double muS = 1.2, muD = 0.35; ///< friction coefficients for the bounds
 };
 
-Color transientColor(int periods);
-Color regimeColor(Regime r);
 
 /// One diagram in the given pixel box (axes, cells, overlays).
 void drawGuettler(Canvas& canvas, double left, double top, double width, double height, const SweepResult& r,

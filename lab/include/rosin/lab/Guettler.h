@@ -11,6 +11,7 @@
 
 #include "rosin/dsp.h"
 #include "rosin/lab/Classifier.h"
+#include "rosin/lab/Playability.h" // guettlerBounds
 
 namespace rosin::lab {
 
@@ -74,12 +75,5 @@ struct BoundaryFit {
     std::vector<double> accelerations, forces; ///< the boundary points used
 };
 BoundaryFit fitLowerBoundary(const SweepResult& r, std::size_t betaIndex = 0);
-
-/// Guettler's theoretical bounds for a lossless string with Coulomb friction (PHYSICS.md 6.3),
-/// read as forces for a given acceleration: lower <= F < upper, both proportional to a.
-struct GuettlerBounds {
-    double lowerPerAccel = 0, upperPerAccel = 0; ///< N per (m/s^2)
-};
-GuettlerBounds guettlerBounds(const dsp::StringParams& s, double beta, double muS, double muD);
 
 } // namespace rosin::lab

@@ -6,20 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "rosin/lab/Painter.h"
+
 typedef struct _cairo cairo_t;
 typedef struct _cairo_surface cairo_surface_t;
 
 namespace rosin::lab {
-
-struct Color {
-    double r = 0, g = 0, b = 0, a = 1;
-};
-
-namespace colors {
-inline constexpr Color black{0, 0, 0}, white{1, 1, 1}, grey{0.55, 0.55, 0.55}, red{0.85, 0.12, 0.1},
-    blue{0.16, 0.33, 0.85}, cyan{0.15, 0.78, 0.9}, green{0.1, 0.6, 0.25}, orange{0.95, 0.55, 0.1}, purple{0.5, 0.2, 0.7},
-    magenta{0.85, 0.1, 0.65};
-}
 
 class Canvas {
 public:
@@ -68,7 +60,22 @@ private:
     bool logX_;
 };
 
-/// Round tick positions covering [lo, hi].
-std::vector<double> niceTicks(double lo, double hi, int target = 6);
+/// The shared Painter on a canvas: the editor's views drawn into PNG figures.
+class CairoPainter : public Painter {
+public:
+    explicit CairoPainter(Canvas& canvas) : canvas_(canvas) {}
+    void fillRect(const Rect& r, Color c) override;
+    void strokeRect(const Rect& r, Color c, double width) override;
+    void line(double x0, double y0, double x1, double y1, Color c, double width, bool dashed) override;
+    void polyline(const std::vector<double>& x, const std::vector<double>& y, Color c, double width) override;
+    void fillCircle(double cx, double cy, double radius, Color c) override;
+    void text(const Rect& box, const std::string& s, double size, Color c, Align align, bool bold) override;
+    void pushClip(const Rect& r) override;
+    void popClip() override;
+
+private:
+    Canvas& canvas_;
+};
+
 
 } // namespace rosin::lab
