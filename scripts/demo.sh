@@ -25,6 +25,9 @@ done
 ./build/lab/rosin render --model enhanced --gesture guettler --force 1.0 --accel 1.0 --duration 0.3 \
   --out out/guettler-stroke
 ./build/lab/rosin guettler --model thermal --fit wg --variants 5 --out out/guettler-thermal
+./build/lab/rosin render --gesture constant --force 1.0 --speed 0.1 --duration 1 --sample-rate 48000 --views \
+  --out out/steady-stroke -q
 echo "demo: listen to out/demo-phrase.wav (the cello plays presets/midi/demo-phrase.mid) and out/articulations/*.wav;"
 echo "      look at out/guettler-thermal.png (data beside it); out/gesture-phrase.wav is one string under a"
-echo "      bowing gesture, out/guettler-stroke.{wav,csv} one stroke in newtons; rosin figures -o out/figures draws the set"
+echo "      bowing gesture, out/guettler-stroke.{wav,csv} one stroke in newtons; out/steady-stroke-views.png the"
+echo "      plugin window's live views for a steady stroke; rosin figures -o out/figures draws the set"

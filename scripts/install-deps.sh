@@ -16,7 +16,8 @@ CORE_PKGS=(
   juce-modules-source lv2-dev libjack-jackd2-dev
   lilv-utils                               # lv2ls / lv2info see the built LV2
   ardour                                   # ardour7-lua: a real DAW loads VST3 and LV2 headless
-  xvfb xauth                               # the Standalone needs an X display
+  xvfb xauth x11-utils                     # the Standalone needs an X display
+  jackd2 xdotool imagemagick               # editor test: JACK dummy audio, a click on its keyboard, screenshots
   libhidapi-dev libusb-1.0-0-dev           # HID controllers (pen tablets, gamepads, 3D mice)
   clang libclang-rt-14-dev                 # libFuzzer for the HID parser fuzz run
 )

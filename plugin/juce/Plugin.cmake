@@ -3,7 +3,7 @@
 find_package(JUCE CONFIG REQUIRED)
 find_package(CLI11 REQUIRED)
 set(ROSIN_JUCE_DEFINITIONS
-  JUCE_WEB_BROWSER=0 JUCE_USE_CURL=0 JUCE_USE_FLAC=0 JUCE_USE_OGGVORBIS=0
+  JUCE_WEB_BROWSER=0 JUCE_USE_CURL=0 JUCE_USE_FLAC=0 JUCE_USE_OGGVORBIS=0 JUCE_JACK=1
   JUCE_DISPLAY_SPLASH_SCREEN=0 JUCE_REPORT_APP_USAGE=0)
 set(ROSIN_LV2_URI "http://rosin-synth.org/plugins/rosin")
 
@@ -25,14 +25,15 @@ juce_add_plugin(RosinPlugin
 
 target_sources(RosinPlugin PRIVATE
   ${CMAKE_CURRENT_SOURCE_DIR}/src/RosinProcessor.cpp
-  ${PROJECT_SOURCE_DIR}/ui/RosinEditor.cpp)
+  ${PROJECT_SOURCE_DIR}/ui/RosinEditor.cpp
+  ${PROJECT_SOURCE_DIR}/ui/LiveViews.cpp)
 target_include_directories(RosinPlugin PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR}/ui)
 target_compile_definitions(RosinPlugin PUBLIC ${ROSIN_JUCE_DEFINITIONS}
   JucePlugin_LV2URI="${ROSIN_LV2_URI}"
   JUCE_VST3_CAN_REPLACE_VST2=0
   ROSIN_SOURCE_PRESET_DIR="${PROJECT_SOURCE_DIR}/presets")
 target_link_libraries(RosinPlugin
-  PRIVATE rosin::engine rosin::hid juce::juce_audio_utils juce::juce_audio_plugin_client ${CMAKE_DL_LIBS}
+  PRIVATE rosin::engine rosin::hid rosin_lab_core rosin_lab_presets juce::juce_audio_utils juce::juce_audio_plugin_client ${CMAKE_DL_LIBS}
   PUBLIC juce::juce_recommended_config_flags juce::juce_recommended_warning_flags)
 
 # Presets travel inside each bundle, so an installed plugin finds them without the source tree.

@@ -156,6 +156,7 @@ std::unique_ptr<engine::Synth> RosinProcessor::buildSynth(const engine::Instrume
     auto synth = std::make_unique<engine::Synth>();
     synth->prepare(sampleRate, preset, currentParams(), &map_);
     synth->setTag(tag);
+    synth->setViewTap(viewRing_.get()); // the window's views follow whichever engine plays
     return synth;
 }
 
@@ -356,6 +357,7 @@ void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBu
         if (room && pending_.compare_exchange_strong(next, nullptr, std::memory_order_acq_rel)) {
             if (current_) {
                 retiring_ = current_;
+                retiring_->setViewTap(nullptr); // the views follow the new engine only
                 retiring_->releaseAll();
                 retiringLeft_ = fadeSamples;
             }
@@ -370,6 +372,8 @@ void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBu
         buffer.clear();
     } else {
         drainHid(*current_);
+        UiMidi m;
+        while (uiMidi_.pop(m)) current_->handleMidi(m.bytes.data(), m.size);
         renderSynth(*current_, buffer, &midi, true);
         activeVoices_.store(current_->activeVoiceCount(), std::memory_order_relaxed);
     }
@@ -451,6 +455,15 @@ void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
     } catch (const std::exception& e) {
         DBG("Rosin: " << e.what());
     }
+}
+
+bool RosinProcessor::pushUiMidi(const std::uint8_t* data, int size) noexcept
+{
+    if (size < 1 || size > 3) return false;
+    UiMidi m;
+    std::copy(data, data + size, m.bytes.begin());
+    m.size = size;
+    return uiMidi_.push(m);
 }
 
 juce::AudioProcessorEditor* RosinProcessor::createEditor() { return new ui::RosinEditor(*this); }

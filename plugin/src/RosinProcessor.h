@@ -17,6 +17,7 @@
 #include "rosin/engine/SpscQueue.h"
 #include "rosin/engine/ControllerMap.h"
 #include "rosin/engine/Synth.h"
+#include "rosin/engine/ViewTap.h"
 #include "rosin/hid/HidInput.h"
 
 namespace rosin::plugin {
@@ -68,7 +69,15 @@ public:
     juce::AudioProcessorValueTreeState& parameters() noexcept { return state_; }
     engine::ControllerMap& controllerMap() noexcept { return map_; }
     juce::String currentInstrument() const;
+    engine::ParamValues currentParams() const; ///< [any thread] the host parameters in engine units
     int activeVoices() const noexcept { return activeVoices_.load(std::memory_order_relaxed); }
+
+    /// The live views' channel: the audio thread writes frames of the newest note while the
+    /// editor listens (ViewRing::setListening); the editor's timer reads them.
+    engine::ViewRing& viewRing() noexcept { return *viewRing_; }
+    double currentSampleRate() const noexcept { return sampleRate_.load(std::memory_order_relaxed); }
+    /// [message thread] A note from the window's keyboard: queued, played at the next block's start.
+    bool pushUiMidi(const std::uint8_t* data, int size) noexcept;
 
 private:
     class Loader;
@@ -79,7 +88,6 @@ private:
     void setPhysical(engine::Param p, double value); ///< [not audio] a parameter by its value in the engine's units
     void pollHid(); ///< [loader thread] start or stop the HID input with its parameter
     void drainHid(engine::Synth& synth) noexcept;
-    engine::ParamValues currentParams() const;
     void renderSynth(engine::Synth& synth, juce::AudioBuffer<float>& buffer, const juce::MidiBuffer* midi,
                      bool pushParams) noexcept;
 
@@ -100,6 +108,12 @@ private:
     static constexpr int fadeSamples = 512;
 
     // Crossing threads.
+    std::unique_ptr<engine::ViewRing> viewRing_ = std::make_unique<engine::ViewRing>(1u << 15);
+    struct UiMidi {
+        std::array<std::uint8_t, 3> bytes{};
+        int size = 0;
+    };
+    engine::SpscQueue<UiMidi, 256> uiMidi_;
     std::atomic<engine::Synth*> pending_{nullptr};
     engine::SpscQueue<engine::Synth*, 16> trash_;
     std::atomic<double> sampleRate_{0.0};

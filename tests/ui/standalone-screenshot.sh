@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# The Standalone as a musician starts it: JACK (dummy backend: no sound card here) as its audio
+# device, a virtual X display, a click held on a key of the window's keyboard, two screenshots
+# 0.4 s apart. Passes when every view region shows signal and the views move between shots.
+# Usage: standalone-screenshot.sh STANDALONE_BINARY ARTEFACT_DIR
+set -euo pipefail
+app="$1"
+out="$2"
+mkdir -p "$out"
+work="$(mktemp -d)"
+server="rosin-ui-$$"
+display=":$((90 + $$ % 100))"
+cleanup() {
+  kill "${app_pid:-}" "${xvfb_pid:-}" "${jack_pid:-}" 2>/dev/null || true
+  wait 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+# The Standalone remembers its audio device in ~/.config/Rosin.settings: point it at JACK.
+mkdir -p "$work/home/.config"
+cat > "$work/home/.config/Rosin.settings" <<'XML'
+<?xml version="1.0" encoding="UTF-8"?>
+<PROPERTIES>
+  <VALUE name="audioSetup">
+    <DEVICESETUP deviceType="JACK" audioOutputDeviceName="system" audioInputDeviceName="system"
+                 audioDeviceRate="48000.0" audioDeviceBufferSize="256"/>
+  </VALUE>
+</PROPERTIES>
+XML
+export HOME="$work/home" JACK_DEFAULT_SERVER="$server" DISPLAY="$display" JACK_NO_AUDIO_RESERVATION=1
+jackd --no-realtime -n "$server" -d dummy -r 48000 -p 256 >"$work/jack.log" 2>&1 &
+jack_pid=$!
+Xvfb "$display" -screen 0 1400x900x24 -nolisten tcp >"$work/xvfb.log" 2>&1 &
+xvfb_pid=$!
+for _ in $(seq 50); do jack_lsp >/dev/null 2>&1 && xdpyinfo >/dev/null 2>&1 && break; sleep 0.2; done
+"$app" >"$work/app.log" 2>&1 &
+app_pid=$!
+win="$(timeout 20 xdotool search --sync --name '^Rosin$' | head -1)"
+sleep 2
+jack_lsp | grep -q "Rosin:out_1" || { echo "FAIL: the Standalone did not open JACK"; cat "$work/app.log"; exit 1; }
+eval "$(xdotool getwindowgeometry --shell "$win")" # X Y WIDTH HEIGHT
+import -window root "$out/standalone-before.png"
+# Hold a key in the middle of the keyboard strip along the bottom of the window.
+xdotool mousemove --window "$win" $((WIDTH * 42 / 100)) $((HEIGHT - 35)) mousedown 1
+sleep 3
+import -window root "$out/standalone-playing.png"
+sleep 0.4
+import -window root "$out/standalone-playing-later.png"
+xdotool mouseup 1
+
+# The four views fill the right part of the window between the top bar and the keyboard.
+vx=$((X + WIDTH * 36 / 100)); vw=$((WIDTH * 62 / 100)); vy=$((Y + HEIGHT * 12 / 100)); vh=$((HEIGHT * 70 / 100))
+fail=0
+for q in 0 1 2 3; do
+  qx=$((vx + (q % 2) * vw / 2 + vw / 12)); qy=$((vy + (q / 2) * vh / 2 + vh / 12))
+  crop="$((vw / 3))x$((vh / 3))+$qx+$qy"
+  colours=$(convert "$out/standalone-playing.png" -crop "$crop" +repage -format "%k" info:)
+  before=$(convert "$out/standalone-before.png" -crop "$crop" +repage -format "%k" info:)
+  echo "view $q: $colours colours while playing ($before before)"
+  if [ "$colours" -lt 40 ] || [ "$colours" -le "$before" ]; then echo "FAIL: view $q shows no signal"; fail=1; fi
+done
+moved=$(compare -metric AE -crop "${vw}x${vh}+${vx}+${vy}" "$out/standalone-playing.png" "$out/standalone-playing-later.png" null: 2>&1 || true)
+echo "pixels changed in the views in 0.4 s: $moved"
+if [ "${moved%%.*}" -lt 500 ]; then echo "FAIL: the views do not move"; fail=1; fi
+exit $fail
