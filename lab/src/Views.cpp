@@ -397,6 +397,9 @@ void drawPlayability(Painter& p, const Rect& r, const ViewTheme& t, const Playab
         }
     // Theory as reference lines: Schelleng's maximum force, Guettler's bounds.
     std::vector<double> xs, ys, xs2, ys2;
+    dsp::StringParams stoppedString = s.config.string;
+    if (s.frequency > 0) stoppedString.length *= stoppedString.fundamental() / s.frequency;
+    const GuettlerBounds bounds = guettlerBounds(stoppedString, s.beta, muS, muD);
     for (int i = 0; i <= 40; ++i) {
         const double u = i / 40.0;
         const double x = schelleng ? ex.front() * std::pow(ex.back() / ex.front(), u) : ex.front() + u * (ex.back() - ex.front());
@@ -404,13 +407,10 @@ void drawPlayability(Painter& p, const Rect& r, const ViewTheme& t, const Playab
             xs.push_back(f.px(x));
             ys.push_back(f.py(std::clamp(schellengMaxForce(map->z0, s.speed, x, muS, muD), ef.front() * 0.5, ef.back() * 2)));
         } else if (x > 0) {
-            dsp::StringParams sp = s.config.string;
-            if (s.frequency > 0) sp.length *= sp.fundamental() / s.frequency;
-            const GuettlerBounds b = guettlerBounds(sp, s.beta, muS, muD);
             xs.push_back(f.px(x));
-            ys.push_back(f.py(std::clamp(b.lowerPerAccel * x, ef.front() * 0.5, ef.back() * 2)));
+            ys.push_back(f.py(std::clamp(bounds.lowerPerAccel * x, ef.front() * 0.5, ef.back() * 2)));
             xs2.push_back(f.px(x));
-            ys2.push_back(f.py(std::clamp(b.upperPerAccel * x, ef.front() * 0.5, ef.back() * 2)));
+            ys2.push_back(f.py(std::clamp(bounds.upperPerAccel * x, ef.front() * 0.5, ef.back() * 2)));
         }
     }
     p.polyline(xs, ys, t.reference, 1.5);
