@@ -160,8 +160,7 @@ void LiveViews::updateMap()
     }
     const double open = instrument_.strings[static_cast<std::size_t>(string)].fundamental();
     const int semitone = frequency > open ? static_cast<int>(std::lround(12.0 * std::log2(frequency / open))) : 0;
-    const double zRef = instrument_.strings[static_cast<std::size_t>(std::min(2, instrument_.stringCount - 1))].impedance();
-    const double force = param(engine::Param::BowForce) * instrument_.strings[static_cast<std::size_t>(string)].impedance() / zRef;
+    const double force = param(engine::Param::BowForce) * engine::stringForceScale(instrument_, string);
     const auto q = [](double x, double step) { return static_cast<long>(std::lround(x / step)); };
     const auto ql = [](double x) { return static_cast<long>(std::lround(std::log(std::max(1e-6, x)) / 0.05)); };
     MapKey key{name, string, semitone, static_cast<int>(kind_),

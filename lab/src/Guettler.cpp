@@ -78,45 +78,21 @@ CellResult runStroke(const SweepSpec& spec, Worker& w, double a, double F, doubl
     s.reset();
     s.junction().setAmbient(p.ambient);
     s.junction().setSlipNoise(p.noise, p.noiseSeed);
-    const double fs = spec.sampleRate, f0 = spec.config.string.fundamental();
-    const auto maxN = static_cast<std::size_t>(spec.maxSeconds * fs);
-    const auto tail = static_cast<std::size_t>(spec.periodsAfterSlip * fs / f0);
-    w.bridge.clear();
-    w.stick.clear();
-    if (trace) trace->clear();
     CellResult r;
     r.acceleration = a;
     r.force = F;
     r.beta = beta;
     r.variant = variant;
-    std::size_t end = maxN, slipAt = 0;
-    bool slipped = false;
-    double previousFriction = 0.0;
-    for (std::size_t n = 0; n < end; ++n) {
-        dsp::BowFrame<double> fr;
-        s.processSample(p.force, p.accel * (static_cast<double>(n) / fs), p.beta, &fr);
-        w.bridge.push_back(fr.bridgeForce);
-        w.stick.push_back(fr.stick ? 1 : 0);
-        if (trace) trace->push_back(fr);
-        r.peakTemperature = std::max(r.peakTemperature, fr.temperature);
-        if (!slipped && !fr.stick) {
-            slipped = true;
-            slipAt = n;
-            r.firstJump = previousFriction - fr.friction;
-            end = std::min(maxN, n + tail);
-        }
-        previousFriction = fr.friction;
-    }
+    const GuettlerStroke g = runGuettlerStroke(s, spec.config, spec.sampleRate, p.accel, p.force, p.beta, spec.periodsAfterSlip,
+                                               spec.maxSeconds, w.bridge, w.stick, trace);
     if (samples) *samples += static_cast<long long>(w.bridge.size());
-    ClassifierInput in = guettlerStrokeInput(w.bridge, fs, f0, p.beta, spec.config.string.impedance(), spec.config.string.tension,
-                                             spec.config.string.length, p.accel);
-    in.stick = w.stick;
-    const Classification c = classify(in);
-    r.regime = c.regime;
-    r.transientPeriods = c.transientPeriods;
-    if (slipped) {
-        r.firstSlipTime = static_cast<double>(slipAt) / fs;
-        r.forceBeforeSlip = slipAt > 0 ? w.bridge[slipAt - 1] : 0.0;
+    r.regime = g.classification.regime;
+    r.transientPeriods = g.classification.transientPeriods;
+    r.peakTemperature = g.peakTemperature;
+    if (g.firstSlip >= 0) {
+        r.firstSlipTime = static_cast<double>(g.firstSlip) / spec.sampleRate;
+        r.forceBeforeSlip = g.firstSlip > 0 ? w.bridge[static_cast<std::size_t>(g.firstSlip) - 1] : 0.0;
+        r.firstJump = g.firstJump;
     }
     return r;
 }

@@ -100,30 +100,11 @@ PlayabilityCell guettlerCell(const PlayabilitySpec& spec, const dsp::BowedString
 {
     // A constant-acceleration stroke from rest, classified as the lab's Guettler sweeps do.
     s.reset();
-    const double fs = spec.sampleRate, f0 = config.string.fundamental();
-    const auto maxN = static_cast<std::size_t>(1.0 * fs), tail = static_cast<std::size_t>(32.0 * fs / f0);
-    bridge.clear();
-    stick.clear();
-    std::size_t end = maxN;
-    bool slipped = false;
-    for (std::size_t n = 0; n < end; ++n) {
-        dsp::BowFrame<double> fr;
-        s.processSample(force, accel * (static_cast<double>(n) / fs), spec.beta, &fr);
-        bridge.push_back(fr.bridgeForce);
-        stick.push_back(fr.stick ? 1 : 0);
-        if (!slipped && !fr.stick) {
-            slipped = true;
-            end = std::min(maxN, n + tail);
-        }
-    }
-    ClassifierInput in = guettlerStrokeInput(bridge, fs, f0, spec.beta, config.string.impedance(), config.string.tension,
-                                             config.string.length, accel);
-    in.stick = stick;
-    const Classification k = classify(in);
+    const GuettlerStroke g = runGuettlerStroke(s, config, spec.sampleRate, accel, force, spec.beta, 32.0, 1.0, bridge, stick);
     PlayabilityCell c;
-    c.regime = k.regime;
-    c.transientPeriods = k.transientPeriods;
-    c.success = k.transientPeriods >= 0;
+    c.regime = g.classification.regime;
+    c.transientPeriods = g.classification.transientPeriods;
+    c.success = c.transientPeriods >= 0;
     return c;
 }
 
@@ -150,6 +131,40 @@ PlayabilitySpec PlayabilitySpec::around(MapKind kind, const dsp::BowedStringConf
         for (int i = 0; i < columns; ++i) s.columns.push_back(top * (i + 1) / columns);
     }
     return s;
+}
+
+GuettlerStroke runGuettlerStroke(dsp::BowedString<double>& s, const dsp::BowedStringConfig& config, double fs, double accel,
+                                 double force, double beta, double periodsAfterSlip, double maxSeconds,
+                                 std::vector<double>& bridge, std::vector<std::uint8_t>& stick,
+                                 std::vector<dsp::BowFrame<double>>* trace)
+{
+    const double f0 = config.string.fundamental();
+    const auto maxN = static_cast<std::size_t>(maxSeconds * fs), tail = static_cast<std::size_t>(periodsAfterSlip * fs / f0);
+    bridge.clear();
+    stick.clear();
+    if (trace) trace->clear();
+    GuettlerStroke g;
+    std::size_t end = maxN;
+    double previousFriction = 0.0;
+    for (std::size_t n = 0; n < end; ++n) {
+        dsp::BowFrame<double> fr;
+        s.processSample(force, accel * (static_cast<double>(n) / fs), beta, &fr);
+        bridge.push_back(fr.bridgeForce);
+        stick.push_back(fr.stick ? 1 : 0);
+        if (trace) trace->push_back(fr);
+        g.peakTemperature = std::max(g.peakTemperature, fr.temperature);
+        if (g.firstSlip < 0 && !fr.stick) {
+            g.firstSlip = static_cast<long>(n);
+            g.firstJump = previousFriction - fr.friction;
+            end = std::min(maxN, n + tail);
+        }
+        previousFriction = fr.friction;
+    }
+    ClassifierInput in = guettlerStrokeInput(bridge, fs, f0, beta, config.string.impedance(), config.string.tension,
+                                             config.string.length, accel);
+    in.stick = stick;
+    g.classification = classify(in);
+    return g;
 }
 
 std::size_t PlayabilityMap::completed() const { return static_cast<std::size_t>(std::count(done.begin(), done.end(), true)); }

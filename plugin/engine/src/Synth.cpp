@@ -46,6 +46,13 @@ dsp::BowedStringConfig stringConfig(const InstrumentPreset& instrument, int s, c
     return c;
 }
 
+double stringForceScale(const InstrumentPreset& instrument, int s)
+{
+    if (s < 0 || s >= instrument.stringCount) return 1.0;
+    const double zRef = instrument.strings[static_cast<std::size_t>(std::min(2, instrument.stringCount - 1))].impedance();
+    return instrument.strings[static_cast<std::size_t>(s)].impedance() / zRef;
+}
+
 void Synth::prepare(double sampleRate, const InstrumentPreset& instrument, const ParamValues& params, ControllerMap* map)
 {
     fs_ = sampleRate;
@@ -60,11 +67,7 @@ void Synth::prepare(double sampleRate, const InstrumentPreset& instrument, const
     for (auto& v : voices_)
         for (int s = 0; s < instrument.stringCount; ++s) v.strings[static_cast<std::size_t>(s)] = templates[static_cast<std::size_t>(s)];
 
-    // The nominal force is the third string's; a player leans harder on thicker strings, and
-    // Schelleng's force limits scale with the string's impedance, so the others scale with Z0.
-    const double zRef = instrument.strings[static_cast<std::size_t>(std::min(2, std::max(0, instrument.stringCount - 1)))].impedance();
-    for (int s = 0; s < maxStrings; ++s)
-        forceScale_[static_cast<std::size_t>(s)] = s < instrument.stringCount ? instrument.strings[static_cast<std::size_t>(s)].impedance() / zRef : 1.0;
+    for (int s = 0; s < maxStrings; ++s) forceScale_[static_cast<std::size_t>(s)] = stringForceScale(instrument, s);
     for (auto& v : voices_) v.gesture.prepare(sampleRate);
     for (auto& b : body_) b.prepare(sampleRate, instrument.body);
     applyBody();

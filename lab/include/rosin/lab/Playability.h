@@ -5,6 +5,7 @@
 // string being played; `rosin playability` writes them as figures.
 #pragma once
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -59,6 +60,20 @@ struct GuettlerBounds {
     double lowerPerAccel = 0, upperPerAccel = 0; ///< N per (m/s^2)
 };
 GuettlerBounds guettlerBounds(const dsp::StringParams& s, double beta, double muS, double muD);
+
+/// One constant-acceleration stroke from rest (v_b = a t) on a prepared, reset string, run until
+/// `periodsAfterSlip` periods after the first slip (or `maxSeconds`), then classified from the
+/// bridge force and the stick record. The one stroke both Guettler's map and `rosin guettler` use.
+struct GuettlerStroke {
+    Classification classification;
+    long firstSlip = -1;        ///< sample of the first slip, -1 if none
+    double firstJump = 0;       ///< friction-force drop at the first slip (N)
+    double peakTemperature = 0; ///< K above ambient
+};
+GuettlerStroke runGuettlerStroke(dsp::BowedString<double>& string, const dsp::BowedStringConfig& config, double sampleRate,
+                                 double accel, double force, double beta, double periodsAfterSlip, double maxSeconds,
+                                 std::vector<double>& bridge, std::vector<std::uint8_t>& stick,
+                                 std::vector<dsp::BowFrame<double>>* trace = nullptr);
 
 /// One cell, deterministic. Exposed for tests.
 PlayabilityCell playabilityCell(const PlayabilitySpec& spec, double column, double force);

@@ -35,6 +35,10 @@ struct ExternalBow {
 /// rosin, ambient, footprint): the voices and the editor's playability map use the same one.
 dsp::BowedStringConfig stringConfig(const InstrumentPreset& instrument, int s, const ParamValues& params);
 
+/// The nominal bow force is the third string's; a player leans harder on thicker strings, and
+/// Schelleng's force limits scale with the string's impedance, so string s gets Z0(s) / Z0(third).
+double stringForceScale(const InstrumentPreset& instrument, int s);
+
 struct VoiceInfo {
     bool active = false;
     int channel = -1, note = -1, stringIndex = -1;
