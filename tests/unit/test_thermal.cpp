@@ -217,3 +217,27 @@ TYPED_TEST(ConductionBankTest, ResetForgetsTheLastKappa)
     fresh.setKappa(1015.0);
     EXPECT_EQ(used.gamma(), fresh.gamma());
 }
+
+// advance() predicts the next step's history from the old pole states (so the temperature does
+// not wait for the whole bank); the prediction must equal the sum over the new states, also
+// across changes of kappa, which void it.
+TYPED_TEST(ConductionBankTest, PredictedHistoryEqualsTheSumOverThePoles)
+{
+    ThermalParams tp;
+    for (double fs : {44100.0, 48000.0, 192000.0}) {
+        ConductionBank<TypeParam> bank;
+        bank.prepare(fs, tp.xiMin, tp.xiMaxOverSampleRate * fs, tp.polesPerDecade);
+        double worst = 0.0, scale = 0.0;
+        for (int n = 0; n < 20000; ++n) {
+            if (n % 700 == 350) bank.setKappa(n % 1400 == 350 ? 800.0 + n * 0.1 : 0.0);
+            const double theta = 20.0 + 15.0 * std::sin(n * 0.05) + (n % 97 == 0 ? 5.0 : 0.0);
+            bank.advance(theta);
+            if (n % 700 == 0) bank.setKappa(1200.0 - n * 0.05); // between a step and the next history
+            worst = std::max(worst, std::abs(bank.history() - bank.recomputedHistory()));
+            scale = std::max(scale, std::abs(bank.recomputedHistory()));
+        }
+        EXPECT_GT(scale, 1.0);
+        const double tolerance = std::is_same_v<TypeParam, float> ? 1e-5 : 1e-12;
+        EXPECT_LT(worst / scale, tolerance) << "fs=" << fs;
+    }
+}

@@ -140,46 +140,16 @@ public:
     {
         const double vh = finiteOr(vhIn), vb = std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed);
         const double fb = std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce);
-        if (fb != forceCached_) { // pow() for the power law: only when the force moves
-            forceCached_ = fb;
-            loadCached_ = area_.effectiveLoad(fb);
-            invLoadCached_ = loadCached_ > 0.0 ? 1.0 / loadCached_ : 0.0;
-        }
+        if (fb != forceCached_) setLoad(fb); // pow() for the power law: only when the force moves
         if (zEff != zEffCached_) {
             zEffCached_ = zEff;
+            twoZ_ = 2.0 * zEff;
             invTwoZ_ = 0.5 / zEff;
         }
-        const double load = loadCached_;
-        const double twoZ = 2.0 * zEff;
-        const double D = vb - vh;
-        const double side = D >= 0.0 ? 1.0 : -1.0;
-        const double fStick = twoZ * D;
-
-        double theta = 0.0, f = 0.0;
-        if (params_.model != FrictionModel::FrictionCurve)
-            // Friction, and so the heat it makes, scales with the load: carried per unit load so a
-            // sudden drop in force does not pour the last sample's heat into a tiny footprint.
-            theta = thermal_.step(heatPerLoadPrev_ * load, slidePrev_, area_.areaPerNewton * load, heatSlopePerLoadPrev_ * load);
-
-        if (params_.model == FrictionModel::Thermal) {
-            const double limit = load * law()(theta);
-            if (std::abs(fStick) <= limit) { f = fStick; state_ = ContactState::Stick; }
-            else { f = side * limit; state_ = side > 0 ? ContactState::SlipForward : ContactState::SlipBackward; }
-        } else {
-            const double scale = params_.model == FrictionModel::Enhanced ? law()(theta) : 1.0;
-            f = solveWithJumpRule(D, fStick, load, scale, twoZ);
-        }
-        if (noiseLevel_ > 0.0 && state_ != ContactState::Stick) f *= 1.0 + noiseLevel_ * nextNoise();
-        const double v = state_ == ContactState::Stick ? vb : vh + f * invTwoZ_;
-        const double dv = std::abs(v - vb);
-        heatPerLoadPrev_ = std::abs(f) * dv * invLoadCached_;
-        slidePrev_ = dv;
-        // d(heat)/d(theta) per unit load at fixed sliding speed, for the semi-implicit step.
-        heatSlopePerLoadPrev_ = 0.0;
-        if (dv > 0.0 && params_.model == FrictionModel::Thermal) heatSlopePerLoadPrev_ = dv * law().slope(theta);
-        if (dv > 0.0 && params_.model == FrictionModel::Enhanced)
-            heatSlopePerLoadPrev_ = dv * speed_(dv).mu * law().slope(theta);
-        return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), state_ == ContactState::Stick};
+        // The thermal model is the instrument's default and the lightest: its own small path,
+        // which the compiler can inline into the voice's loop; the others share one out of line.
+        if (params_.model == FrictionModel::Thermal) return solveThermal(vh, vb);
+        return solveSpeedDependent(vh, vb);
     }
 
     /// Largest friction force the contact can hold without slipping at temperature theta and
@@ -301,6 +271,74 @@ private:
         return x;
     }
 
+    void setLoad(double fb) noexcept
+    {
+        forceCached_ = fb;
+        loadCached_ = area_.effectiveLoad(fb);
+        invLoadCached_ = loadCached_ > 0.0 ? 1.0 / loadCached_ : 0.0;
+    }
+
+    /// Friction and heat carry per unit load, so a sudden drop in force does not pour the last
+    /// sample's heat into a tiny footprint.
+    double stepTemperature() noexcept
+    {
+        const double load = loadCached_;
+        return thermal_.step(heatPerLoadPrev_ * load, slidePrev_, area_.areaPerNewton * load, heatSlopePerLoadPrev_ * load);
+    }
+
+    JunctionResult<T> solveThermal(double vh, double vb) noexcept
+    {
+        const double load = loadCached_;
+        const double D = vb - vh;
+        const double fStick = twoZ_ * D;
+        const double theta = stepTemperature();
+        const MuSlope m = thermalLaw_.at(theta);
+        const double limit = load * m.mu;
+        if (std::abs(fStick) <= limit) {
+            // Sticking makes no heat. Stored as constants, not computed from f and dv (which are
+            // zero anyway), so the next temperature does not wait for this sample's friction.
+            state_ = ContactState::Stick;
+            heatPerLoadPrev_ = 0.0;
+            slidePrev_ = 0.0;
+            heatSlopePerLoadPrev_ = 0.0;
+            return {static_cast<T>(fStick), static_cast<T>(vb), static_cast<T>(theta), true};
+        }
+        const bool forward = D >= 0.0;
+        double f = forward ? limit : -limit;
+        state_ = forward ? ContactState::SlipForward : ContactState::SlipBackward;
+        if (noiseLevel_ > 0.0) f *= 1.0 + noiseLevel_ * nextNoise();
+        const double v = vh + f * invTwoZ_;
+        const double dv = std::abs(v - vb);
+        heatPerLoadPrev_ = std::abs(f) * dv * invLoadCached_;
+        slidePrev_ = dv;
+        // d(heat)/d(theta) per unit load at fixed sliding speed, for the semi-implicit step.
+        heatSlopePerLoadPrev_ = dv > 0.0 ? dv * m.slope : 0.0;
+        return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), false};
+    }
+
+    /// Friction-curve and enhanced models: mu falls with sliding speed (the jump rule).
+    [[gnu::noinline]] JunctionResult<T> solveSpeedDependent(double vh, double vb) noexcept
+    {
+        const double load = loadCached_;
+        const double D = vb - vh;
+        const double fStick = twoZ_ * D;
+        double theta = 0.0, scale = 1.0;
+        if (params_.model == FrictionModel::Enhanced) {
+            theta = stepTemperature();
+            scale = enhancedLaw_(theta);
+        }
+        double f = solveWithJumpRule(D, fStick, load, scale, twoZ_);
+        if (noiseLevel_ > 0.0 && state_ != ContactState::Stick) f *= 1.0 + noiseLevel_ * nextNoise();
+        const double v = state_ == ContactState::Stick ? vb : vh + f * invTwoZ_;
+        const double dv = std::abs(v - vb);
+        heatPerLoadPrev_ = std::abs(f) * dv * invLoadCached_;
+        slidePrev_ = dv;
+        heatSlopePerLoadPrev_ = 0.0;
+        if (dv > 0.0 && params_.model == FrictionModel::Enhanced)
+            heatSlopePerLoadPrev_ = dv * speed_(dv).mu * enhancedLaw_.slope(theta);
+        return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), state_ == ContactState::Stick};
+    }
+
     FrictionParams params_;
     ContactArea area_;
     TemperatureLaw thermalLaw_, enhancedLaw_;
@@ -309,7 +347,7 @@ private:
     double xPrev_ = 0.0, heatPerLoadPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePerLoadPrev_ = 0.0;
     SpeedLaw speed_;
     double muAtRest_ = 1.0, forceCached_ = -1.0, loadCached_ = 0.0, invLoadCached_ = 0.0;
-    double zEffCached_ = -1.0, invTwoZ_ = 0.0;
+    double zEffCached_ = -1.0, twoZ_ = 1.0, invTwoZ_ = 0.0;
     double noiseLevel_ = 0.0;
     std::uint64_t noiseState_ = 1;
 };

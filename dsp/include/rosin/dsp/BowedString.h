@@ -47,7 +47,9 @@ public:
     /// Returns the bridge force; fills `frame` when given.
     T processSample(T force, T speed, T beta, BowFrame<T>* frame = nullptr) noexcept
     {
-        waveguide_.setBeta(static_cast<double>(beta));
+        // The bow rarely moves along the string: skip the call (it clamps, so an out-of-range
+        // beta still goes through and is ignored there).
+        if (static_cast<double>(beta) != waveguide_.beta()) waveguide_.setBeta(static_cast<double>(beta));
         const T vh = waveguide_.beginSample();
         const JunctionResult<T> r = junction_.solve(vh, speed, force, zEff_);
         waveguide_.endSample(r.force);

@@ -1,4 +1,8 @@
 // Circular delay line with an interpolated read. Memory is reserved in prepare() only.
+//
+// Every sample is written twice, at i and at i + size, so any run of up to `size` recent
+// samples sits contiguously in memory: a four-point read is one index computation and four
+// neighbouring loads instead of four wrapped ones (reads are most of a voice's memory work).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -16,7 +20,8 @@ public:
     {
         std::size_t size = 8;
         while (static_cast<double>(size) < maxDelaySamples + 8.0) size <<= 1;
-        buffer_.assign(size, T(0));
+        buffer_.assign(2 * size, T(0));
+        size_ = size;
         mask_ = size - 1;
         writeIndex_ = 0;
     }
@@ -24,7 +29,7 @@ public:
     void reset() noexcept { std::fill(buffer_.begin(), buffer_.end(), T(0)); writeIndex_ = 0; }
 
     /// Largest delay (samples) that read() accepts.
-    double capacity() const noexcept { return static_cast<double>(buffer_.size()) - 5.0; }
+    double capacity() const noexcept { return static_cast<double>(size_) - 5.0; }
 
     /// Read position and interpolation weights for one delay. Computing them is the costly
     /// part of a fractional read, and delays change only when the bow moves, so callers keep
@@ -70,16 +75,21 @@ public:
 
     T read(const Tap& t) const noexcept
     {
-        return t.h0 * at(t.base) + t.h1 * at(t.base + 1) + t.h2 * at(t.base + 2) + t.h3 * at(t.base + 3);
+        const T* p = run(t.base + 3); // p[3] is delay base, p[0] delay base + 3
+        return t.h0 * p[3] + t.h1 * p[2] + t.h2 * p[1] + t.h3 * p[0];
     }
 
     /// Weighted sum of samples at delays first, first + 1, ... (an FIR read of any kernel).
     T readKernel(std::size_t first, const T* weights, int count) const noexcept
     {
+        const T* p = run(first + static_cast<std::size_t>(count) - 1); // p[count - 1 - k] is delay first + k
         T acc = T(0);
-        for (int k = 0; k < count; ++k) acc += weights[k] * at(first + static_cast<std::size_t>(k));
+        for (int k = 0; k < count; ++k) acc += weights[k] * p[count - 1 - k];
         return acc;
     }
+
+    /// The four samples a tap weighs, oldest first: p[0] is delay base + 3, p[3] delay base.
+    const T* stencil(const Tap& t) const noexcept { return run(t.base + 3); }
 
     /// Convenience for tests and setup code: tap and read in one.
     T read(double delay) const noexcept { return read(tap(delay)); }
@@ -87,6 +97,7 @@ public:
     void write(T value) noexcept
     {
         buffer_[writeIndex_] = value;
+        buffer_[writeIndex_ + size_] = value;
         writeIndex_ = (writeIndex_ + 1) & mask_;
     }
 
@@ -100,8 +111,11 @@ public:
 
 private:
     T at(std::size_t delay) const noexcept { return buffer_[(writeIndex_ - delay) & mask_]; }
+    /// Start of the contiguous run from delay `oldest` up to the newest samples (oldest <= size).
+    const T* run(std::size_t oldest) const noexcept { return buffer_.data() + ((writeIndex_ - oldest) & mask_); }
 
-    std::vector<T> buffer_;
+    std::vector<T> buffer_; // 2 x size_: the second half mirrors the first
+    std::size_t size_ = 0;
     std::size_t mask_ = 0;
     std::size_t writeIndex_ = 0;
 };

@@ -15,6 +15,7 @@
 #include "Config.h"
 #include "DelayLine.h"
 #include "ReflectionFilter.h"
+#include "Simd.h"
 #include "StringParams.h"
 
 namespace rosin::dsp {
@@ -27,6 +28,10 @@ struct WaveguideOptions {
     /// MSW83 Gaussian-pulse reflections instead of one-pole loss + Lagrange delay (a second,
     /// independent design: data simulated with it tests that analysis does not depend on ours).
     bool gaussianReflections = false;
+    /// Plain strings (one-pole losses, no dispersion, no touched harmonic) run their four lossy
+    /// reflections as the lanes of one SIMD pack; false runs them one at a time. Same equations,
+    /// summed in another order: kept to check the packed path against.
+    bool packedReflections = true;
     /// Lowest fundamental the delay lines must hold, as a fraction of the open string's: a
     /// playable voice bends below the open pitch; research runs keep 1.
     double lowestPitchRatio = 1.0;
@@ -43,6 +48,8 @@ public:
         options_ = options;
         z0_ = params.impedance();
         zt_ = params.torsionImpedance();
+        halfAdmittance_ = static_cast<T>(0.5 / z0_); // a multiply per sample instead of a divide
+        halfTorsionAdmittance_ = static_cast<T>(0.5 / zt_);
         f0_ = params.fundamental();
         w0_ = 2.0 * std::numbers::pi * f0_ / fs_;
         fLossProbe_ = std::min(5.0 * f0_, 0.4 * fs_);
@@ -54,6 +61,7 @@ public:
             line->prepare(period / std::min(1.0, params.torsionSpeedRatio) + 16.0);
         harmonic_ = 0;
         designDispersion();
+        updatePlain();
         beta_ = -1.0;
         setBeta(0.0899);
         reset();
@@ -63,11 +71,10 @@ public:
     {
         for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_, &nodeBack_, &nodeRound_})
             line->reset();
-        for (auto* f : {&lossBridge_, &lossFinger_, &lossTorsionBridge_, &lossTorsionFinger_}) f->reset();
+        lossState_ = Pack4{};
         dispersion_.reset();
         u1In_ = u2In_ = u1tIn_ = u2tIn_ = T(0);
         bridgeForce_ = T(0);
-        farEndForce_ = T(0);
     }
 
     /// [audio thread] Stops the string (a finger) so it sounds at f (Hz): the vibrating length
@@ -100,6 +107,7 @@ public:
         harmonic_ = n;
         nodeDamping_ = r;
         designNode();
+        updatePlain();
     }
     int harmonic() const noexcept { return harmonic_; }
 
@@ -129,7 +137,17 @@ public:
         tapFinger_ = fingerSide_.tap(delayFinger_);
         tapTorsionBridge_ = torsionBridge_.tap(delayTorsionBridge_);
         tapTorsionFinger_ = torsionFinger_.tap(delayTorsionFinger_);
-        tapFarEnd_ = fingerSide_.tap(0.5 * tau2 * fs_); // one way, bow to finger
+        // One way, bow to finger, read after this sample's write: one sample further back.
+        tapFarEnd_ = fingerSide_.tap(0.5 * tau2 * fs_ + 1.0);
+        const OnePoleLoss<T>* loss[4] = {&lossBridge_, &lossFinger_, &lossTorsionBridge_, &lossTorsionFinger_};
+        for (int k = 0; k < 4; ++k) {
+            lossB0_[k] = loss[k]->b0;
+            lossA1_[k] = loss[k]->a1;
+        }
+        weightsBridgeOut_ = stencilWeights(tapBridgeOut_);
+        weightsFinger_ = stencilWeights(tapFinger_);
+        weightsTorsionBridge_ = stencilWeights(tapTorsionBridge_);
+        weightsTorsionFinger_ = stencilWeights(tapTorsionFinger_);
         designNode();
         if (options_.gaussianReflections) {
             auto design = [&](GaussianReflection<T>& g, double delay, double tau, bool torsional) {
@@ -151,9 +169,9 @@ public:
     /// [audio thread] Reads the incoming waves of this sample; returns v_h (PHYSICS.md 1.3).
     T beginSample() noexcept
     {
+        if (plain_) return beginSamplePacked();
         const T arriving = bridgeOut_.read(tapBridgeOut_);
-        farEndForce_ = static_cast<T>(2.0 * z0_) * fingerSide_.read(tapFarEnd_);
-        const T reflected = -lossBridge_.process(arriving);
+        const T reflected = -loss(kBridge, arriving);
         bridgeForce_ = static_cast<T>(z0_) * (arriving - reflected);
         if (options_.gaussianReflections) return beginSampleGaussian(arriving);
         u1In_ = bridgeBack_.read(tapBridgeBack_);
@@ -161,17 +179,17 @@ public:
         if (harmonic_ > 0) {
             // Finger side split at the touched node: bow <-> node (A), node <-> finger end (B).
             const T aIn = fingerSide_.read(tapNodeA_);
-            const T bIn = -lossFinger_.process(dispersion_.process(nodeRound_.read(tapNodeRound_)));
+            const T bIn = -loss(kFinger, dispersion_.process(nodeRound_.read(tapNodeRound_)));
             const T v = nodeGain_ * (aIn + bIn); // 2Z (a + b) / (2Z + R)
             u2In_ = nodeBack_.read(tapNodeBack_);
             nodeBack_.write(v - aIn);
             nodeRound_.write(v - bIn);
         } else {
-            u2In_ = -lossFinger_.process(dispersion_.process(fingerSide_.read(tapFinger_)));
+            u2In_ = -loss(kFinger, dispersion_.process(fingerSide_.read(tapFinger_)));
         }
         if (options_.torsion) {
-            u1tIn_ = -lossTorsionBridge_.process(torsionBridge_.read(tapTorsionBridge_));
-            u2tIn_ = -lossTorsionFinger_.process(torsionFinger_.read(tapTorsionFinger_));
+            u1tIn_ = -loss(kTorsionBridge, torsionBridge_.read(tapTorsionBridge_));
+            u2tIn_ = -loss(kTorsionFinger, torsionFinger_.read(tapTorsionFinger_));
         }
         return u1In_ + u2In_ + u1tIn_ + u2tIn_;
     }
@@ -179,11 +197,11 @@ public:
     /// [audio thread] Launches the outgoing waves for friction force f (bow on string).
     void endSample(T f) noexcept
     {
-        const T dv = f / static_cast<T>(2.0 * z0_);
+        const T dv = f * halfAdmittance_;
         bridgeOut_.write(u2In_ + dv);
         fingerSide_.write(u1In_ + dv);
         if (options_.torsion) {
-            const T dvt = f / static_cast<T>(2.0 * zt_);
+            const T dvt = f * halfTorsionAdmittance_;
             torsionBridge_.write(u2tIn_ + dvt);
             torsionFinger_.write(u1tIn_ + dvt);
         }
@@ -191,9 +209,10 @@ public:
 
     /// Force of the string on the bridge for the current sample (valid after beginSample).
     T bridgeForce() const noexcept { return bridgeForce_; }
-    /// Force on the far (finger or nut) end for the current sample, for two-ended measurements
-    /// (PHYSICS.md 7.2): twice Z0 times the wave arriving there, signed like the bridge force.
-    T farEndForce() const noexcept { return farEndForce_; }
+    /// Force on the far (finger or nut) end for the sample just completed (call after
+    /// endSample), for two-ended measurements (PHYSICS.md 7.2): twice Z0 times the wave
+    /// arriving there, signed like the bridge force. Read on demand: a voice never needs it.
+    T farEndForce() const noexcept { return static_cast<T>(2.0 * z0_) * fingerSide_.read(tapFarEnd_); }
 
     /// Transverse part of the history velocity (what the bow would see with torsion ignored).
     T transverseHistory() const noexcept { return u1In_ + u2In_; }
@@ -230,6 +249,50 @@ public:
     double fingerRoundTripDelay() const noexcept { return delayFinger_; }
 
 private:
+    typedef simd::Pack4<T> Pack4;
+    /// Lanes of the four lossy reflections: the waves arriving at the bridge and at the finger,
+    /// transverse and torsional.
+    static constexpr int kBridge = 0, kFinger = 1, kTorsionBridge = 2, kTorsionFinger = 3;
+
+    /// One-pole loss of one reflection (its lane of the packed filter state).
+    T loss(int lane, T x) noexcept
+    {
+        const T y = lossB0_[lane] * x - lossA1_[lane] * lossState_[lane];
+        lossState_[lane] = y;
+        return y;
+    }
+
+    static Pack4 stencilWeights(const typename DelayLine<T>::Tap& t) noexcept { return Pack4{t.h3, t.h2, t.h1, t.h0}; }
+
+    /// The plain string (one-pole losses, no dispersion, no touched harmonic; torsion on or off),
+    /// which is what a playing voice runs: the four lossy reflections are four lanes of one
+    /// pack, read (four 4-point stencils), summed and filtered together. Same equations as the
+    /// general path, summed in a different order.
+    T beginSamplePacked() noexcept
+    {
+        const Pack4 reads = simd::sumEach<T>(simd::load4(bridgeOut_.stencil(tapBridgeOut_)) * weightsBridgeOut_,
+                                             simd::load4(fingerSide_.stencil(tapFinger_)) * weightsFinger_,
+                                             simd::load4(torsionBridge_.stencil(tapTorsionBridge_)) * weightsTorsionBridge_,
+                                             simd::load4(torsionFinger_.stencil(tapTorsionFinger_)) * weightsTorsionFinger_);
+        const Pack4 filtered = lossB0_ * reads - lossA1_ * lossState_;
+        lossState_ = filtered;
+        const T arriving = reads[kBridge];
+        bridgeForce_ = static_cast<T>(z0_) * (arriving + filtered[kBridge]);
+        u1In_ = bridgeBack_.read(tapBridgeBack_);
+        bridgeBack_.write(-filtered[kBridge]);
+        u2In_ = -filtered[kFinger];
+        if (options_.torsion) { // the torsional lines are silent otherwise; their lanes are ignored
+            u1tIn_ = -filtered[kTorsionBridge];
+            u2tIn_ = -filtered[kTorsionFinger];
+        }
+        return u1In_ + u2In_ + u1tIn_ + u2tIn_;
+    }
+
+    void updatePlain() noexcept
+    {
+        plain_ = options_.packedReflections && !options_.gaussianReflections && dispersion_.sections == 0 && harmonic_ == 0;
+    }
+
     /// Gaussian-pulse variant: the reflection at the bridge is pure (sign only) and the whole
     /// bridge-side smear and loss sits in the way back; the bridge sees the arriving wave.
     T beginSampleGaussian(T arriving) noexcept
@@ -309,14 +372,17 @@ private:
     DelayLine<T> bridgeOut_, bridgeBack_, fingerSide_, torsionBridge_, torsionFinger_, nodeBack_, nodeRound_;
     int harmonic_ = 0;
     double nodeDamping_ = 1.0;
-    T nodeGain_ = T(1);
+    T nodeGain_ = T(1), halfAdmittance_ = T(1), halfTorsionAdmittance_ = T(1);
+    bool plain_ = true;
+    Pack4 lossB0_{}, lossA1_{}, lossState_{};
+    Pack4 weightsBridgeOut_{}, weightsFinger_{}, weightsTorsionBridge_{}, weightsTorsionFinger_{};
     OnePoleLoss<T> lossBridge_, lossFinger_, lossTorsionBridge_, lossTorsionFinger_;
     DispersionChain<T> dispersion_;
     GaussianReflection<T> gaussBridge_, gaussFinger_, gaussTorsionBridge_, gaussTorsionFinger_;
     double delayBridgeOut_ = 1, delayBridgeBack_ = 1, delayFinger_ = 1, delayTorsionBridge_ = 1, delayTorsionFinger_ = 1;
     typename DelayLine<T>::Tap tapBridgeOut_, tapBridgeBack_, tapFinger_, tapTorsionBridge_, tapTorsionFinger_, tapFarEnd_;
     typename DelayLine<T>::Tap tapNodeA_, tapNodeBack_, tapNodeRound_;
-    T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0), farEndForce_ = T(0);
+    T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0);
 };
 
 } // namespace rosin::dsp

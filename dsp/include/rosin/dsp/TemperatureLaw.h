@@ -79,6 +79,19 @@ public:
         return scale_ * (table_[i] + s * (table_[i + 1] - table_[i]));
     }
 
+    /// Both at once (one index computation): what the junction needs every sample.
+    MuSlope at(double theta) const noexcept
+    {
+        const double x = (theta + shift_) * invStep_;
+        const double* t = table_.data();
+        if (!(x >= 0.0)) return {scale_ * t[0], 0.0};
+        if (x >= static_cast<double>(table_.size() - 1)) return {scale_ * table_.back(), 0.0};
+        const auto i = static_cast<std::size_t>(x);
+        const double s = x - static_cast<double>(i);
+        const double d = t[i + 1] - t[i];
+        return {scale_ * (t[i] + s * d), scale_ * d * invStep_};
+    }
+
     /// d/d(theta) of operator(), one-sided on the table grid (0 where the law is clamped).
     double slope(double theta) const noexcept
     {

@@ -47,6 +47,7 @@ public:
         // Pad to whole blocks with inert poles (zero weight) so the hot loops vectorise.
         // Unused slots are inert (zero weight); every loop runs over all of them.
         for (int k = count_; k < N; ++k) { xi_[k] = 1.0; weight_[k] = 0.0; baseDecay_[k] = 0.0; }
+        packs_ = (count_ + kLanes - 1) / kLanes; // the per-sample loops skip packs of inert poles
         for (int k = 0; k < N; ++k) {
             xiT_[k / kLanes][k % kLanes] = static_cast<T>(xi_[k]);
             weightT_[k / kLanes][k % kLanes] = static_cast<T>(weight_[k]);
@@ -62,6 +63,8 @@ public:
     {
         for (Pack& z : z_) z = Pack{};
         thetaPrev_ = 0.0;
+        nextHistory_ = 0.0; // no history yet: exact, not a prediction
+        nextHistoryValid_ = true;
         // The 2 % rule of setKappa remembers the last kappa: forget it, so a reset bank
         // behaves exactly like a freshly prepared one.
         kappa_ = -1.0;
@@ -77,39 +80,54 @@ public:
         kappa_ = kappa;
         // Runs on most slipping samples: kept in T and in packs so it vectorises.
         const T ek = static_cast<T>(std::exp(-kappa * h_)), kap = static_cast<T>(kappa);
-        Pack g{};
+        Pack g{}, c{};
         for (int p = 0; p < kPacks; ++p) {
             const Pack eps = baseDecayT_[p] * ek;
             const Pack b = (T(1) - eps) / (xiT_[p] + kap);
             decay_[p] = eps;
             gain_[p] = b;
             historyWeight_[p] = weightXiT_[p] * eps;
+            historyDecay_[p] = historyWeight_[p] * eps;
             g += weightT_[p] * (T(1) - xiT_[p] * b);
+            c += historyWeight_[p] * b;
         }
-        double gamma = 0.0;
-        for (int j = 0; j < kLanes; ++j) gamma += static_cast<double>(g[j]);
+        double gamma = 0.0, gain = 0.0;
+        for (int j = 0; j < kLanes; ++j) {
+            gamma += static_cast<double>(g[j]);
+            gain += static_cast<double>(c[j]);
+        }
         gamma_ = gamma;
         gammaTotal_ = gamma + tailCapacity_ * (1.0 / h_ + kappa);
+        historyGain_ = gain + tailRate_;
+        nextHistoryValid_ = false; // predicted with the old weights
     }
 
     /// This step's flux (per unit area and effusivity) is gamma() * theta_new - history().
     double gamma() const noexcept { return gammaTotal_; }
 
     /// History part of this step's flux (depends on past states only).
-    double history() const noexcept
+    double history() const noexcept { return nextHistoryValid_ ? nextHistory_ : recomputedHistory(); }
+
+    /// The same, summed from the pole states now (what the prediction in advance() must equal).
+    double recomputedHistory() const noexcept
     {
         Pack acc = historyWeight_[0] * z_[0];
-        for (int p = 1; p < kPacks; ++p) acc += historyWeight_[p] * z_[p];
-        T s = T(0);
-        for (int j = 0; j < kLanes; ++j) s += acc[j];
-        return static_cast<double>(s) + tailRate_ * thetaPrev_;
+        for (int p = 1; p < packs_; ++p) acc += historyWeight_[p] * z_[p];
+        return static_cast<double>(sum(acc)) + tailRate_ * thetaPrev_;
     }
 
     /// Commit the step with the new temperature.
-    void advance(T theta) noexcept
+    ///
+    /// Also predicts the next step's history, sum(w xi eps z') + tail theta with
+    /// z' = eps z + b theta, as sum(w xi eps^2 z) + (sum(w xi eps b) + tail) theta: the pole sum
+    /// then needs only the old states, so it runs while theta is still being solved, and theta
+    /// reaches the next step through one multiply-add instead of the whole bank (the
+    /// sample-to-sample chain is what limits a voice's speed). setKappa() voids the prediction.
+    void advance(double theta) noexcept
     {
-        for (int p = 0; p < kPacks; ++p) z_[p] = decay_[p] * z_[p] + gain_[p] * theta;
-        thetaPrev_ = static_cast<double>(theta);
+        // A fixed pack count unrolls the loops; 44.1-96 kHz need one pack fewer than the slots.
+        if (packs_ == kPacks - 1) advancePacks<kPacks - 1>(theta, kPacks - 1);
+        else advancePacks<kPacks>(theta, packs_);
     }
 
     /// Flux (per unit area and effusivity) if the temperature is held at theta from now on
@@ -129,11 +147,41 @@ private:
     typedef T Pack __attribute__((vector_size(16)));
     static constexpr int kLanes = 16 / static_cast<int>(sizeof(T));
     static constexpr int kPacks = N / kLanes;
+
+    /// P: packs the compiler unrolls for; packs: how many carry poles (<= P).
+    template <int P>
+    void advancePacks(double theta, int packs) noexcept
+    {
+        const T th = static_cast<T>(theta);
+        Pack q = historyDecay_[0] * z_[0];
+        for (int p = 1; p < P; ++p)
+            if (p < packs) q += historyDecay_[p] * z_[p];
+        for (int p = 0; p < P; ++p)
+            if (p < packs) z_[p] = decay_[p] * z_[p] + gain_[p] * th;
+        nextHistory_ = static_cast<double>(sum(q)) + historyGain_ * static_cast<double>(th);
+        nextHistoryValid_ = true;
+        thetaPrev_ = static_cast<double>(th);
+    }
+
+    /// Sum of the lanes by halving (two shuffles for floats, one for doubles).
+    static T sum(Pack x) noexcept
+    {
+        if constexpr (kLanes == 4) {
+            x += __builtin_shufflevector(x, x, 2, 3, 0, 1);
+            x += __builtin_shufflevector(x, x, 1, 0, 3, 2);
+        } else {
+            x += __builtin_shufflevector(x, x, 1, 0);
+        }
+        return x[0];
+    }
+
     double h_ = 1.0 / 48000.0, kappa_ = -1.0, gamma_ = 0.0, gammaTotal_ = 0.0, tailCapacity_ = 0.0, tailRate_ = 0.0, thetaPrev_ = 0.0;
-    int count_ = 0;
+    double historyGain_ = 0.0, nextHistory_ = 0.0;
+    bool nextHistoryValid_ = true;
+    int count_ = 0, packs_ = kPacks;
     std::array<double, N> xi_{}, weight_{}, baseDecay_{};
     // Plain arrays: GCC drops the vector attribute of Pack inside std::array<Pack, ...>.
-    Pack z_[kPacks]{}, decay_[kPacks]{}, gain_[kPacks]{}, historyWeight_[kPacks]{};
+    Pack z_[kPacks]{}, decay_[kPacks]{}, gain_[kPacks]{}, historyWeight_[kPacks]{}, historyDecay_[kPacks]{};
     Pack xiT_[kPacks]{}, weightT_[kPacks]{}, weightXiT_[kPacks]{}, baseDecayT_[kPacks]{};
 };
 
@@ -150,6 +198,7 @@ public:
         const double xiMax = params.xiMaxOverSampleRate * sampleRate;
         stringSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade);
         rodSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade);
+        areaCached_ = -1.0; // the per-area terms depend on the parameters just set
         reset();
     }
 
@@ -158,6 +207,7 @@ public:
         stringSide_.reset();
         rodSide_.reset();
         theta_ = 0.0;
+        denCached_ = 0.0;
     }
 
     /// [audio thread] One implicit step (PHYSICS.md 3.4). heat = |f dv| and slidingSpeed = |dv|
@@ -171,34 +221,36 @@ public:
         if (!(area > 0.0)) {
             // Bow off the string: no contact, the rosin spot relaxes to ambient.
             theta_ = 0.0;
-            stringSide_.advance(T(0));
+            stringSide_.advance(0.0);
             rodSide_.setKappa(0.0);
-            rodSide_.advance(T(0));
+            rodSide_.advance(0.0);
             return theta_;
         }
-        if (area != areaCached_) {
+        if (area != areaCached_) { // everything here follows the bow force only
             areaCached_ = area;
-            radiusCached_ = std::sqrt(area / std::numbers::pi);
-            renewalPerSpeed_ = 3.0 / (8.0 * radiusCached_);
+            const double radius = std::sqrt(area / std::numbers::pi);
+            const double rhoCDelta = params_.rosinHeatCapacity * params_.layerThickness;
+            renewalPerSpeed_ = 3.0 / (8.0 * radius);
+            storage_ = rhoCDelta * area * rate_;
+            advectionPerSpeed_ = rhoCDelta * params_.advectionWidthFactor * radius;
+            stringEffusion_ = area * params_.stringEffusivity;
+            rodEffusion_ = area * params_.rodEffusivity;
         }
-        const double radius = radiusCached_;
-        const double rhoCDelta = params_.rosinHeatCapacity * params_.layerThickness;
-        const double storage = rhoCDelta * area * rate_;
-        const double advection = rhoCDelta * params_.advectionWidthFactor * radius * slidingSpeed;
         rodSide_.setKappa(renewalPerSpeed_ * slidingSpeed); // kappa = 3 |dv| / (8 a)
-        const double es = area * params_.stringEffusivity, er = area * params_.rodEffusivity;
         const double slope = std::min(heatSlope, 0.0);
-        const double num = storage * theta_ + heat - slope * theta_ + es * stringSide_.history() + er * rodSide_.history();
+        const double num = (storage_ - slope) * theta_ + heat + stringEffusion_ * stringSide_.history()
+                           + rodEffusion_ * rodSide_.history();
         // While sticking nothing in the denominator moves, so its reciprocal is reused: the
         // division sits on the sample-to-sample dependency chain and is its slowest link.
-        const double den = storage + advection - slope + es * stringSide_.gamma() + er * rodSide_.gamma();
+        const double den = storage_ + advectionPerSpeed_ * slidingSpeed - slope + stringEffusion_ * stringSide_.gamma()
+                           + rodEffusion_ * rodSide_.gamma();
         if (den != denCached_) {
             denCached_ = den;
             invDenCached_ = 1.0 / den;
         }
         theta_ = std::max(0.0, num * invDenCached_);
-        stringSide_.advance(static_cast<T>(theta_));
-        rodSide_.advance(static_cast<T>(theta_));
+        stringSide_.advance(theta_);
+        rodSide_.advance(theta_);
         return theta_;
     }
 
@@ -207,7 +259,8 @@ public:
 
 private:
     ThermalParams params_;
-    double h_ = 1.0 / 48000.0, rate_ = 48000.0, theta_ = 0.0, areaCached_ = -1.0, radiusCached_ = 0.0, renewalPerSpeed_ = 0.0, denCached_ = 0.0, invDenCached_ = 0.0;
+    double h_ = 1.0 / 48000.0, rate_ = 48000.0, theta_ = 0.0, areaCached_ = -1.0, denCached_ = 0.0, invDenCached_ = 0.0;
+    double renewalPerSpeed_ = 0.0, storage_ = 0.0, advectionPerSpeed_ = 0.0, stringEffusion_ = 0.0, rodEffusion_ = 0.0;
     ConductionBank<T> stringSide_, rodSide_;
 };
 
