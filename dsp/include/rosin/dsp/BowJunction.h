@@ -286,6 +286,15 @@ private:
         return thermal_.step(heatPerLoadPrev_ * load, slidePrev_, area_.areaPerNewton * load, heatSlopePerLoadPrev_ * load);
     }
 
+    /// What this sample leaves for the next temperature step: heat |f dv| and sliding speed, and
+    /// d(heat)/d(theta) at fixed sliding speed for the semi-implicit step (all per unit load).
+    void keepHeat(double f, double dv, double heatSlopePerLoad) noexcept
+    {
+        heatPerLoadPrev_ = std::abs(f) * dv * invLoadCached_;
+        slidePrev_ = dv;
+        heatSlopePerLoadPrev_ = heatSlopePerLoad;
+    }
+
     JunctionResult<T> solveThermal(double vh, double vb) noexcept
     {
         const double load = loadCached_;
@@ -309,10 +318,7 @@ private:
         if (noiseLevel_ > 0.0) f *= 1.0 + noiseLevel_ * nextNoise();
         const double v = vh + f * invTwoZ_;
         const double dv = std::abs(v - vb);
-        heatPerLoadPrev_ = std::abs(f) * dv * invLoadCached_;
-        slidePrev_ = dv;
-        // d(heat)/d(theta) per unit load at fixed sliding speed, for the semi-implicit step.
-        heatSlopePerLoadPrev_ = dv > 0.0 ? dv * m.slope : 0.0;
+        keepHeat(f, dv, dv > 0.0 ? dv * m.slope : 0.0);
         return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), false};
     }
 
@@ -331,11 +337,8 @@ private:
         if (noiseLevel_ > 0.0 && state_ != ContactState::Stick) f *= 1.0 + noiseLevel_ * nextNoise();
         const double v = state_ == ContactState::Stick ? vb : vh + f * invTwoZ_;
         const double dv = std::abs(v - vb);
-        heatPerLoadPrev_ = std::abs(f) * dv * invLoadCached_;
-        slidePrev_ = dv;
-        heatSlopePerLoadPrev_ = 0.0;
-        if (dv > 0.0 && params_.model == FrictionModel::Enhanced)
-            heatSlopePerLoadPrev_ = dv * speed_(dv).mu * enhancedLaw_.slope(theta);
+        const bool heats = dv > 0.0 && params_.model == FrictionModel::Enhanced;
+        keepHeat(f, dv, heats ? dv * speed_(dv).mu * enhancedLaw_.slope(theta) : 0.0);
         return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), state_ == ContactState::Stick};
     }
 

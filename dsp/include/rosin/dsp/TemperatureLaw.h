@@ -68,18 +68,9 @@ public:
 
     /// Friction coefficient (or y) at contact rise theta above ambient, with the rosin and
     /// ambient shift and the footprint ratio applied. Clamped at both ends of the table.
-    double operator()(double theta) const noexcept
-    {
-        const double x = (theta + shift_) * invStep_;
-        if (!(x > 0.0)) return scale_ * table_.front();
-        const auto last = static_cast<double>(table_.size() - 1);
-        if (x >= last) return scale_ * table_.back();
-        const auto i = static_cast<std::size_t>(x);
-        const double s = x - static_cast<double>(i);
-        return scale_ * (table_[i] + s * (table_[i + 1] - table_[i]));
-    }
+    double operator()(double theta) const noexcept { return at(theta).mu; }
 
-    /// Both at once (one index computation): what the junction needs every sample.
+    /// Both at once, from one index computation (the junction needs both every slipping sample).
     MuSlope at(double theta) const noexcept
     {
         const double x = (theta + shift_) * invStep_;
@@ -93,13 +84,7 @@ public:
     }
 
     /// d/d(theta) of operator(), one-sided on the table grid (0 where the law is clamped).
-    double slope(double theta) const noexcept
-    {
-        const double x = (theta + shift_) * invStep_;
-        if (!(x >= 0.0) || x >= static_cast<double>(table_.size() - 1)) return 0.0;
-        const auto i = static_cast<std::size_t>(x);
-        return scale_ * (table_[i + 1] - table_[i]) * invStep_;
-    }
+    double slope(double theta) const noexcept { return at(theta).slope; }
 
     /// Unshifted, unscaled table value at theta (what the inversion itself produced).
     double raw(double theta) const noexcept
