@@ -75,7 +75,7 @@ public:
 
     T read(const Tap& t) const noexcept
     {
-        const T* p = run(t.base + 3); // p[3] is delay base, p[0] delay base + 3
+        const T* p = stencil(t);
         return t.h0 * p[3] + t.h1 * p[2] + t.h2 * p[1] + t.h3 * p[0];
     }
 

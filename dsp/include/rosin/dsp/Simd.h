@@ -1,6 +1,6 @@
 // Four lanes of T as one value (GCC/Clang vector extension): 16 bytes of floats or 32 bytes
-// of doubles. The compiler maps them to whatever the target has (SSE2 pairs for doubles, one
-// AVX register where the voice is built for AVX2), so the code stays portable and plain.
+// of doubles. The compiler maps them to what the target has (one SSE register for floats, a
+// pair for doubles on baseline x86-64), so the code stays portable and plain.
 #pragma once
 
 namespace rosin::dsp::simd {
@@ -18,9 +18,8 @@ struct PackOf4<double> {
 template <typename T>
 using Pack4 = typename PackOf4<T>::type;
 
-/// Four neighbouring values from any address, one at a time: delay lines are read a few
-/// samples after their scalar writes, and a wide load spanning several pending stores waits for
-/// all of them to retire (store forwarding only serves a load from one store).
+/// Four neighbouring values from any address (built lane by lane: delay lines are written one
+/// sample at a time, and a lane-wise build makes no alignment or aliasing assumption).
 template <typename T>
 inline Pack4<T> load4(const T* p) noexcept
 {

@@ -96,7 +96,6 @@ public:
             gamma += static_cast<double>(g[j]);
             gain += static_cast<double>(c[j]);
         }
-        gamma_ = gamma;
         gammaTotal_ = gamma + tailCapacity_ * (1.0 / h_ + kappa);
         historyGain_ = gain + tailRate_;
         nextHistoryValid_ = false; // predicted with the old weights
@@ -175,7 +174,7 @@ private:
         return x[0];
     }
 
-    double h_ = 1.0 / 48000.0, kappa_ = -1.0, gamma_ = 0.0, gammaTotal_ = 0.0, tailCapacity_ = 0.0, tailRate_ = 0.0, thetaPrev_ = 0.0;
+    double h_ = 1.0 / 48000.0, kappa_ = -1.0, gammaTotal_ = 0.0, tailCapacity_ = 0.0, tailRate_ = 0.0, thetaPrev_ = 0.0;
     double historyGain_ = 0.0, nextHistory_ = 0.0;
     bool nextHistoryValid_ = true;
     int count_ = 0, packs_ = kPacks;
