@@ -101,6 +101,69 @@ TEST(BowedString, BlockSizeDoesNotChangeTheOutput)
     }
 }
 
+// processBlock runs a playing voice (plain string, thermal model, no frames) through its own
+// loop with the switches fixed at compile time, and reads short delay lines with narrow loads.
+// It must give processSample's output bit for bit, in float and double, with torsion on and
+// off, while the bow moves far enough that the shortest line crosses the narrow-load threshold.
+template <typename T>
+class VoiceLoop : public ::testing::Test {};
+using VoiceLoopTypes = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(VoiceLoop, VoiceLoopTypes);
+
+TYPED_TEST(VoiceLoop, MatchesProcessSampleBitForBit)
+{
+    using T = TypeParam;
+    const double fs = 48000.0;
+    const int n = 30000;
+    std::vector<T> force(n), speed(n), beta(n);
+    for (int i = 0; i < n; ++i) {
+        force[i] = T(0.5 + 0.3 * std::sin(i * 7e-4));
+        speed[i] = T(0.25 * std::sin(i * 2.5e-4));
+        beta[i] = T(0.14 + 0.11 * std::sin(i * 3e-4)); // 0.03..0.25: torsional bridge side 2..32 samples
+    }
+    for (bool torsion : {true, false}) {
+        BowedStringConfig c;
+        c.waveguide.torsion = torsion;
+        BowedString<T> reference, voice, traced;
+        for (auto* s : {&reference, &voice, &traced}) s->prepare(fs, c);
+        ASSERT_TRUE(voice.waveguide().packed());
+        std::vector<T> expected(n), out(n), outTraced(n);
+        std::vector<BowFrame<T>> frames(n);
+        int slips = 0;
+        for (int i = 0; i < n; ++i) {
+            BowFrame<T> f;
+            expected[i] = reference.processSample(force[i], speed[i], beta[i], &f);
+            slips += f.stick ? 0 : 1;
+        }
+        for (int start = 0; start < n; start += 333) {
+            const int len = std::min(333, n - start);
+            voice.processBlock(&force[start], &speed[start], &beta[start], &out[start], len);
+            traced.processBlock(&force[start], &speed[start], &beta[start], &outTraced[start], len, &frames[start]);
+        }
+        EXPECT_GT(slips, n / 50) << "the gesture must make the string slip, or the slip path goes untested";
+        for (int i = 0; i < n; ++i) {
+            ASSERT_EQ(out[i], expected[i]) << "torsion " << torsion << " sample " << i;
+            ASSERT_EQ(outTraced[i], expected[i]) << "torsion " << torsion << " sample " << i;
+        }
+    }
+}
+
+TEST(Simd, NarrowLoadReadsTheSameFourValues)
+{
+    const float f[6] = {1.5f, -2.25f, 3.0f, 4.75f, -5.5f, 6.0f};
+    const double d[6] = {1.5, -2.25, 3.0, 4.75, -5.5, 6.0};
+    for (int k = 0; k < 3; ++k) {
+        const auto a = simd::load4Narrow(f + k), b = simd::load4(f + k);
+        const auto c = simd::load4Narrow(d + k), e = simd::load4(d + k);
+        for (int j = 0; j < 4; ++j) {
+            EXPECT_EQ(a[j], f[k + j]);
+            EXPECT_EQ(b[j], f[k + j]);
+            EXPECT_EQ(c[j], d[k + j]);
+            EXPECT_EQ(e[j], d[k + j]);
+        }
+    }
+}
+
 template <typename T>
 class Robustness : public ::testing::Test {};
 using SampleTypes = ::testing::Types<float, double>;

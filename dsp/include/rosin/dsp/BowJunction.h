@@ -140,16 +140,20 @@ public:
     {
         const double vh = finiteOr(vhIn), vb = std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed);
         const double fb = std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce);
-        if (fb != forceCached_) setLoad(fb); // pow() for the power law: only when the force moves
-        if (zEff != zEffCached_) {
-            zEffCached_ = zEff;
-            twoZ_ = 2.0 * zEff;
-            invTwoZ_ = 0.5 / zEff;
-        }
+        updateLoadLine(fb, zEff);
         // The thermal model is the instrument's default and the lightest: its own small path,
         // which the compiler can inline into the voice's loop; the others share one out of line.
         if (params_.model == FrictionModel::Thermal) return solveThermal(vh, vb);
         return solveSpeedDependent(vh, vb);
+    }
+
+    /// solve() for a junction known to run the thermal model (a voice's inner loop checks the
+    /// model once per block instead of every sample).
+    [[gnu::always_inline]] JunctionResult<T> solveThermalModel(T vhIn, T vbIn, T fbIn, double zEff) noexcept
+    {
+        const double vh = finiteOr(vhIn), vb = std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed);
+        updateLoadLine(std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce), zEff);
+        return solveThermal(vh, vb);
     }
 
     /// Largest friction force the contact can hold without slipping at temperature theta and
@@ -271,6 +275,16 @@ private:
         return x;
     }
 
+    void updateLoadLine(double fb, double zEff) noexcept
+    {
+        if (fb != forceCached_) setLoad(fb); // pow() for the power law: only when the force moves
+        if (zEff != zEffCached_) {
+            zEffCached_ = zEff;
+            twoZ_ = 2.0 * zEff;
+            invTwoZ_ = 0.5 / zEff;
+        }
+    }
+
     void setLoad(double fb) noexcept
     {
         forceCached_ = fb;
@@ -295,7 +309,7 @@ private:
         heatSlopePerLoadPrev_ = heatSlopePerLoad;
     }
 
-    JunctionResult<T> solveThermal(double vh, double vb) noexcept
+    [[gnu::always_inline]] JunctionResult<T> solveThermal(double vh, double vb) noexcept
     {
         const double load = loadCached_;
         const double D = vb - vh;

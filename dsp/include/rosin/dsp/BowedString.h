@@ -63,6 +63,13 @@ public:
     void processBlock(const T* force, const T* speed, const T* beta, T* out, int n,
                       BowFrame<T>* frames = nullptr) noexcept
     {
+        // A playing voice (plain string, thermal model, no research frames) gets a loop with its
+        // switches fixed at compile time: the same calls as processSample, so the same output.
+        if (!frames && waveguide_.packed() && junction_.params().model == FrictionModel::Thermal) {
+            if (waveguide_.options().torsion) processPlainThermal<true>(force, speed, beta, out, n);
+            else processPlainThermal<false>(force, speed, beta, out, n);
+            return;
+        }
         for (int i = 0; i < n; ++i) out[i] = processSample(force[i], speed[i], beta[i], frames ? frames + i : nullptr);
     }
 
@@ -83,6 +90,18 @@ public:
     const BowedStringConfig& config() const noexcept { return config_; }
 
 private:
+    template <bool Torsion>
+    void processPlainThermal(const T* force, const T* speed, const T* beta, T* out, int n) noexcept
+    {
+        for (int i = 0; i < n; ++i) {
+            if (static_cast<double>(beta[i]) != waveguide_.beta()) waveguide_.setBeta(static_cast<double>(beta[i]));
+            const T vh = waveguide_.template beginSamplePacked<Torsion>();
+            const JunctionResult<T> r = junction_.solveThermalModel(vh, speed[i], force[i], zEff_);
+            waveguide_.template endSampleWith<Torsion>(r.force);
+            out[i] = waveguide_.bridgeForce();
+        }
+    }
+
     BowedStringConfig config_;
     StringWaveguide<T> waveguide_;
     BowJunction<T> junction_;

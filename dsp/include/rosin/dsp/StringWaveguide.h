@@ -169,7 +169,7 @@ public:
     /// [audio thread] Reads the incoming waves of this sample; returns v_h (PHYSICS.md 1.3).
     T beginSample() noexcept
     {
-        if (plain_) return beginSamplePacked();
+        if (plain_) return options_.torsion ? beginSamplePacked<true>() : beginSamplePacked<false>();
         const T arriving = bridgeOut_.read(tapBridgeOut_);
         const T reflected = -loss(kBridge, arriving);
         bridgeForce_ = static_cast<T>(z0_) * (arriving - reflected);
@@ -195,12 +195,16 @@ public:
     }
 
     /// [audio thread] Launches the outgoing waves for friction force f (bow on string).
-    void endSample(T f) noexcept
+    void endSample(T f) noexcept { options_.torsion ? endSampleWith<true>(f) : endSampleWith<false>(f); }
+
+    /// endSample() with the torsion switch known at compile time (a voice's inner loop).
+    template <bool Torsion>
+    void endSampleWith(T f) noexcept
     {
         const T dv = f * halfAdmittance_;
         bridgeOut_.write(u2In_ + dv);
         fingerSide_.write(u1In_ + dv);
-        if (options_.torsion) {
+        if (Torsion) {
             const T dvt = f * halfTorsionAdmittance_;
             torsionBridge_.write(u2tIn_ + dvt);
             torsionFinger_.write(u1tIn_ + dvt);
@@ -248,7 +252,14 @@ public:
     double bridgeRoundTripDelay() const noexcept { return delayBridgeOut_ + delayBridgeBack_; }
     double fingerRoundTripDelay() const noexcept { return delayFinger_; }
 
+    /// True when beginSample() takes the packed path (a plain string): a voice's inner loop
+    /// then calls beginSamplePacked<torsion>() itself and skips the per-sample dispatch.
+    bool packed() const noexcept { return plain_; }
+
 private:
+    template <typename>
+    friend class BowedString;
+
     typedef simd::Pack4<T> Pack4;
     /// Lanes of the four lossy reflections: the waves arriving at the bridge and at the finger,
     /// transverse and torsional.
@@ -264,16 +275,29 @@ private:
 
     static Pack4 stencilWeights(const typename DelayLine<T>::Tap& t) noexcept { return Pack4{t.h3, t.h2, t.h1, t.h0}; }
 
+    /// A tap's four samples. Short delays read narrow (see simd::load4Narrow): a line a few
+    /// samples long reads what the last samples wrote. The branch follows the bow position,
+    /// so it is predicted.
+    static Pack4 loadStencil(const DelayLine<T>& line, const typename DelayLine<T>::Tap& t) noexcept
+    {
+        const T* p = line.stencil(t);
+        return t.base < kRecentSamples ? simd::load4Narrow(p) : simd::load4(p);
+    }
+    /// Stencils whose newest sample is younger than this read narrow. The stores of the last
+    /// few samples are what matters; 8 covers them with room.
+    static constexpr std::size_t kRecentSamples = 4;
+
     /// The plain string (one-pole losses, no dispersion, no touched harmonic; torsion on or off),
     /// which is what a playing voice runs: the four lossy reflections are four lanes of one
     /// pack, read (four 4-point stencils), summed and filtered together. Same equations as the
     /// general path, summed in a different order.
+    template <bool Torsion>
     T beginSamplePacked() noexcept
     {
-        const Pack4 reads = simd::sumEach<T>(simd::load4(bridgeOut_.stencil(tapBridgeOut_)) * weightsBridgeOut_,
-                                             simd::load4(fingerSide_.stencil(tapFinger_)) * weightsFinger_,
-                                             simd::load4(torsionBridge_.stencil(tapTorsionBridge_)) * weightsTorsionBridge_,
-                                             simd::load4(torsionFinger_.stencil(tapTorsionFinger_)) * weightsTorsionFinger_);
+        const Pack4 reads = simd::sumEach<T>(loadStencil(bridgeOut_, tapBridgeOut_) * weightsBridgeOut_,
+                                             loadStencil(fingerSide_, tapFinger_) * weightsFinger_,
+                                             loadStencil(torsionBridge_, tapTorsionBridge_) * weightsTorsionBridge_,
+                                             loadStencil(torsionFinger_, tapTorsionFinger_) * weightsTorsionFinger_);
         const Pack4 filtered = lossB0_ * reads - lossA1_ * lossState_;
         lossState_ = filtered;
         const T arriving = reads[kBridge];
@@ -281,7 +305,7 @@ private:
         u1In_ = bridgeBack_.read(tapBridgeBack_);
         bridgeBack_.write(-filtered[kBridge]);
         u2In_ = -filtered[kFinger];
-        if (options_.torsion) { // the torsional lines are silent otherwise; their lanes are ignored
+        if (Torsion) { // the torsional lines are silent otherwise; their lanes are ignored
             u1tIn_ = -filtered[kTorsionBridge];
             u2tIn_ = -filtered[kTorsionFinger];
         }

@@ -63,6 +63,8 @@ public:
         shift_ = tp.temperatureShift();
         scale_ = tp.footprintRatio;
         invStep_ = 1.0 / step_;
+        lastIndex_ = static_cast<double>(m - 1);
+        tableLast_ = table_.back();
         built_ = true;
     }
 
@@ -76,7 +78,7 @@ public:
         const double x = (theta + shift_) * invStep_;
         const double* t = table_.data();
         if (!(x >= 0.0)) return {scale_ * t[0], 0.0};
-        if (x >= static_cast<double>(table_.size() - 1)) return {scale_ * table_.back(), 0.0};
+        if (x >= lastIndex_) return {scale_ * tableLast_, 0.0};
         const auto i = static_cast<std::size_t>(x);
         const double s = x - static_cast<double>(i);
         const double d = t[i + 1] - t[i];
@@ -115,6 +117,7 @@ private:
     std::vector<double> table_{1.0, 1.0};
     bool built_ = false;
     double step_ = 1.0, invStep_ = 1.0, thetaMax_ = 1.0, shift_ = 0.0, scale_ = 1.0;
+    double lastIndex_ = 1.0, tableLast_ = 1.0; // the clamp at() tests every sample, kept at hand
 };
 
 } // namespace rosin::dsp
