@@ -19,6 +19,26 @@ TEST(DelayLine, IntegerDelayIsExact)
     }
 }
 
+// Reads are one add from the write index into the mirrored half (no wrap): every delay from
+// the shortest to the capacity must return the right sample, through several wraps of the buffer.
+TEST(DelayLine, EveryDelayReadsTheRightSampleThroughWraps)
+{
+    DelayLine<float> line;
+    line.prepare(40); // 64 slots, capacity 59
+    const int maxDelay = static_cast<int>(line.capacity());
+    ASSERT_GE(maxDelay, 40);
+    for (int n = 0; n < 400; ++n) { // > 6 wraps
+        for (int d = 1; d <= std::min(n, maxDelay); ++d) {
+            ASSERT_EQ(line.read(static_cast<double>(d)), static_cast<float>(n - d)) << "delay " << d << " at " << n;
+            const auto t = line.tap(static_cast<double>(d) + 0.5);
+            const float* p = line.stencil(t); // oldest first: delays base + 3 .. base
+            if (n >= static_cast<int>(t.base) + 3)
+                for (int k = 0; k < 4; ++k) ASSERT_EQ(p[k], static_cast<float>(n - static_cast<int>(t.base) - 3 + k));
+        }
+        line.write(static_cast<float>(n));
+    }
+}
+
 TEST(DelayLine, FractionalDelayShiftsPhaseOfALowSine)
 {
     DelayLine<double> line;

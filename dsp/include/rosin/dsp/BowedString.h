@@ -5,6 +5,15 @@
 #include "BowJunction.h"
 #include "StringWaveguide.h"
 
+// The voice loop is also compiled for AVX2 and AVX-512 machines, picked at load time (GNU
+// ifunc). Results stay bit-identical to the baseline build because the project compiles with
+// -ffp-contract=off (no fused multiply-add): wider and more registers, the same arithmetic.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(ROSIN_NO_CLONES)
+#define ROSIN_VOICE_CLONES __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4"), flatten))
+#else
+#define ROSIN_VOICE_CLONES
+#endif
+
 namespace rosin::dsp {
 
 struct BowedStringConfig {
@@ -91,7 +100,7 @@ public:
 
 private:
     template <bool Torsion>
-    void processPlainThermal(const T* force, const T* speed, const T* beta, T* out, int n) noexcept
+    ROSIN_VOICE_CLONES void processPlainThermal(const T* force, const T* speed, const T* beta, T* out, int n) noexcept
     {
         for (int i = 0; i < n; ++i) {
             if (static_cast<double>(beta[i]) != waveguide_.beta()) waveguide_.setBeta(static_cast<double>(beta[i]));

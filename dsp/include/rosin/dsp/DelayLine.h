@@ -36,6 +36,9 @@ public:
     /// a Tap and refresh it then.
     struct Tap {
         std::size_t base = 1; ///< delay of the first stencil point
+        /// Where the stencil starts relative to the write index, in the mirrored half (size -
+        /// base - 3): a read is then one add, no wrap. Valid for lines of the size it was made for.
+        std::size_t offset = 0;
         T h0 = T(1), h1 = T(0), h2 = T(0), h3 = T(0);
     };
 
@@ -57,6 +60,7 @@ public:
         Tap t;
         if (n < 2) {
             t.base = 1; // linear between delays 1 and 2 (n == 1 here)
+            t.offset = size_ - 4;
             t.h0 = T(1) - frac;
             t.h1 = frac;
             t.h2 = t.h3 = T(0);
@@ -66,6 +70,7 @@ public:
         const T x = T(1) + frac;
         const T x0 = x, x1 = x - T(1), x2 = x - T(2), x3 = x - T(3);
         t.base = n - 1;
+        t.offset = size_ - (t.base + 3);
         t.h0 = -x1 * x2 * x3 / T(6);
         t.h1 = x0 * x2 * x3 / T(2);
         t.h2 = -x0 * x1 * x3 / T(2);
@@ -89,7 +94,7 @@ public:
     }
 
     /// The four samples a tap weighs, oldest first: p[0] is delay base + 3, p[3] delay base.
-    const T* stencil(const Tap& t) const noexcept { return run(t.base + 3); }
+    const T* stencil(const Tap& t) const noexcept { return buffer_.data() + writeIndex_ + t.offset; }
 
     /// Convenience for tests and setup code: tap and read in one.
     T read(double delay) const noexcept { return read(tap(delay)); }
