@@ -241,3 +241,53 @@ TYPED_TEST(ConductionBankTest, PredictedHistoryEqualsTheSumOverThePoles)
         EXPECT_LT(worst / scale, tolerance) << "fs=" << fs;
     }
 }
+
+// ThermalContact::step reuses the denominator of the implicit update (and its reciprocal)
+// while the contact is still. Against the update written out from two conduction banks, every
+// sample, through slips, sticks, a force change during a stick (new area) and a lifted bow:
+// the reuse must never serve a stale value.
+TEST(ThermalContact, StepEqualsTheImplicitUpdateWrittenOut)
+{
+    const double fs = 48000.0;
+    ThermalParams p;
+    ThermalContact<double> contact;
+    contact.prepare(fs, p);
+    ConductionBank<double> stringSide, rodSide;
+    stringSide.prepare(fs, p.xiMin, p.xiMaxOverSampleRate * fs, p.polesPerDecade);
+    rodSide.prepare(fs, p.xiMin, p.xiMaxOverSampleRate * fs, p.polesPerDecade);
+    double theta = 0.0, hottest = 0.0;
+    int stills = 0, moving = 0;
+    for (int n = 0; n < 6000; ++n) {
+        const int phase = (n / 37) % 4;                       // slip, stick, slip, stick ...
+        const bool slipping = phase == 0 || phase == 2;
+        const double force = n < 3000 ? 0.5 : (n < 4000 ? 0.8 : 0.0); // new area mid-stick, then lifted
+        const double area = force * 2e-7;
+        const double sliding = slipping ? 0.3 + 0.1 * std::sin(n * 0.01) : 0.0;
+        const double heat = slipping ? 0.2 * force * sliding : 0.0;
+        const double slope = slipping ? -0.01 * force : 0.0;
+        const double got = contact.step(heat, sliding, area, slope);
+        double expected = 0.0;
+        if (area > 0.0) {
+            const double radius = std::sqrt(area / std::numbers::pi);
+            const double rhoCDelta = p.rosinHeatCapacity * p.layerThickness;
+            rodSide.setKappa(3.0 / (8.0 * radius) * sliding);
+            const double storage = rhoCDelta * area * fs;
+            const double num = (storage - slope) * theta + heat + area * p.stringEffusivity * stringSide.history()
+                               + area * p.rodEffusivity * rodSide.history();
+            const double den = storage + rhoCDelta * p.advectionWidthFactor * radius * sliding - slope
+                               + area * p.stringEffusivity * stringSide.gamma() + area * p.rodEffusivity * rodSide.gamma();
+            expected = std::max(0.0, num / den);
+        } else {
+            rodSide.setKappa(0.0);
+        }
+        stringSide.advance(expected);
+        rodSide.advance(expected);
+        theta = expected;
+        hottest = std::max(hottest, theta);
+        (slipping ? moving : stills) += 1;
+        ASSERT_NEAR(got, expected, 1e-12 * (1.0 + std::abs(expected))) << "sample " << n;
+    }
+    EXPECT_GT(stills, 2000);
+    EXPECT_GT(moving, 2000);
+    EXPECT_GT(hottest, 1.0); // the contact really heats (K), so the comparison has something to compare
+}

@@ -72,11 +72,11 @@ public:
     }
 
     /// [audio thread] Surface-renewal rate (1/s). Coefficients are recomputed only when it moves
-    /// by more than 2 % (or to/from zero), which during sticking is never.
-    void setKappa(double kappa) noexcept
+    /// by more than 2 % (or to/from zero), which during sticking is never. True when they were.
+    bool setKappa(double kappa) noexcept
     {
-        if (kappa == kappa_) return;
-        if (kappa > 0.0 && kappa_ > 0.0 && std::abs(kappa - kappa_) < 0.02 * kappa_) return;
+        if (kappa == kappa_) return false;
+        if (kappa > 0.0 && kappa_ > 0.0 && std::abs(kappa - kappa_) < 0.02 * kappa_) return false;
         kappa_ = kappa;
         // Runs on most slipping samples: kept in T and in packs so it vectorises.
         const T ek = static_cast<T>(std::exp(-kappa * h_)), kap = static_cast<T>(kappa);
@@ -99,6 +99,7 @@ public:
         gammaTotal_ = gamma + tailCapacity_ * (1.0 / h_ + kappa);
         historyGain_ = gain + tailRate_;
         nextHistoryValid_ = false; // predicted with the old weights
+        return true;
     }
 
     /// This step's flux (per unit area and effusivity) is gamma() * theta_new - history().
@@ -207,6 +208,7 @@ public:
         rodSide_.reset();
         theta_ = 0.0;
         denCached_ = 0.0;
+        denStill_ = false;
     }
 
     /// [audio thread] One implicit step (PHYSICS.md 3.4). heat = |f dv| and slidingSpeed = |dv|
@@ -223,10 +225,13 @@ public:
             stringSide_.advance(0.0);
             rodSide_.setKappa(0.0);
             rodSide_.advance(0.0);
+            denStill_ = false;
             return theta_;
         }
+        bool denStale = !denStill_;
         if (area != areaCached_) { // everything here follows the bow force only
             areaCached_ = area;
+            denStale = true;
             const double radius = std::sqrt(area / std::numbers::pi);
             const double rhoCDelta = params_.rosinHeatCapacity * params_.layerThickness;
             renewalPerSpeed_ = 3.0 / (8.0 * radius);
@@ -235,18 +240,23 @@ public:
             stringEffusion_ = area * params_.stringEffusivity;
             rodEffusion_ = area * params_.rodEffusivity;
         }
-        rodSide_.setKappa(renewalPerSpeed_ * slidingSpeed); // kappa = 3 |dv| / (8 a)
+        if (rodSide_.setKappa(renewalPerSpeed_ * slidingSpeed)) denStale = true; // kappa = 3 |dv| / (8 a)
         const double slope = std::min(heatSlope, 0.0);
         const double num = (storage_ - slope) * theta_ + heat + stringEffusion_ * stringSide_.history()
                            + rodEffusion_ * rodSide_.history();
-        // While sticking nothing in the denominator moves, so its reciprocal is reused: the
-        // division sits on the sample-to-sample dependency chain and is its slowest link.
-        const double den = storage_ + advectionPerSpeed_ * slidingSpeed - slope + stringEffusion_ * stringSide_.gamma()
-                           + rodEffusion_ * rodSide_.gamma();
-        if (den != denCached_) {
-            denCached_ = den;
-            invDenCached_ = 1.0 / den;
+        // While sticking nothing in the denominator moves (no sliding, no heat slope, the same
+        // area and rod weights), so neither it nor its reciprocal is recomputed: the division
+        // sits on the sample-to-sample dependency chain and is its slowest link.
+        const bool still = slidingSpeed == 0.0 && slope == 0.0;
+        if (denStale || !still) {
+            const double den = storage_ + advectionPerSpeed_ * slidingSpeed - slope + stringEffusion_ * stringSide_.gamma()
+                               + rodEffusion_ * rodSide_.gamma();
+            if (den != denCached_) {
+                denCached_ = den;
+                invDenCached_ = 1.0 / den;
+            }
         }
+        denStill_ = still;
         theta_ = std::max(0.0, num * invDenCached_);
         stringSide_.advance(theta_);
         rodSide_.advance(theta_);
@@ -259,6 +269,7 @@ public:
 private:
     ThermalParams params_;
     double h_ = 1.0 / 48000.0, rate_ = 48000.0, theta_ = 0.0, areaCached_ = -1.0, denCached_ = 0.0, invDenCached_ = 0.0;
+    bool denStill_ = false; // denCached_ was computed for a still contact (see step)
     double renewalPerSpeed_ = 0.0, storage_ = 0.0, advectionPerSpeed_ = 0.0, stringEffusion_ = 0.0, rodEffusion_ = 0.0;
     ConductionBank<T> stringSide_, rodSide_;
 };
