@@ -138,22 +138,19 @@ public:
     /// zEff: impedance seen by the bow. Non-finite inputs are treated as zero.
     JunctionResult<T> solve(T vhIn, T vbIn, T fbIn, double zEff) noexcept
     {
-        const double vh = finiteOr(vhIn), vb = std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed);
-        const double fb = std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce);
-        updateLoadLine(fb, zEff);
+        const Speeds s = takeInputs(vhIn, vbIn, fbIn, zEff);
         // The thermal model is the instrument's default and the lightest: its own small path,
         // which the compiler can inline into the voice's loop; the others share one out of line.
-        if (params_.model == FrictionModel::Thermal) return solveThermal(vh, vb);
-        return solveSpeedDependent(vh, vb);
+        if (params_.model == FrictionModel::Thermal) return solveThermal(s.history, s.bow);
+        return solveSpeedDependent(s.history, s.bow);
     }
 
     /// solve() for a junction known to run the thermal model (a voice's inner loop checks the
     /// model once per block instead of every sample).
     [[gnu::always_inline]] JunctionResult<T> solveThermalModel(T vhIn, T vbIn, T fbIn, double zEff) noexcept
     {
-        const double vh = finiteOr(vhIn), vb = std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed);
-        updateLoadLine(std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce), zEff);
-        return solveThermal(vh, vb);
+        const Speeds s = takeInputs(vhIn, vbIn, fbIn, zEff);
+        return solveThermal(s.history, s.bow);
     }
 
     /// Largest friction force the contact can hold without slipping at temperature theta and
@@ -273,6 +270,18 @@ private:
             if (done) return x;
         }
         return x;
+    }
+
+    struct Speeds {
+        double history, bow;
+    };
+
+    /// Non-finite inputs become zero, speed and force are clamped; the load line follows the
+    /// force and impedance. Returns v_h and v_b.
+    Speeds takeInputs(T vhIn, T vbIn, T fbIn, double zEff) noexcept
+    {
+        updateLoadLine(std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce), zEff);
+        return {finiteOr(vhIn), std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed)};
     }
 
     void updateLoadLine(double fb, double zEff) noexcept
