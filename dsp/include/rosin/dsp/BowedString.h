@@ -56,9 +56,7 @@ public:
     /// Returns the bridge force; fills `frame` when given.
     T processSample(T force, T speed, T beta, BowFrame<T>* frame = nullptr) noexcept
     {
-        // The bow rarely moves along the string: skip the call (it clamps, so an out-of-range
-        // beta still goes through and is ignored there).
-        if (static_cast<double>(beta) != waveguide_.beta()) waveguide_.setBeta(static_cast<double>(beta));
+        followBow(beta);
         const T vh = waveguide_.beginSample();
         const JunctionResult<T> r = junction_.solve(vh, speed, force, zEff_);
         waveguide_.endSample(r.force);
@@ -99,11 +97,18 @@ public:
     const BowedStringConfig& config() const noexcept { return config_; }
 
 private:
+    /// The bow rarely moves along the string: skip the call (setBeta clamps, so an out-of-range
+    /// beta still goes through and is ignored there).
+    void followBow(T beta) noexcept
+    {
+        if (static_cast<double>(beta) != waveguide_.beta()) waveguide_.setBeta(static_cast<double>(beta));
+    }
+
     template <bool Torsion>
     ROSIN_VOICE_CLONES void processPlainThermal(const T* force, const T* speed, const T* beta, T* out, int n) noexcept
     {
         for (int i = 0; i < n; ++i) {
-            if (static_cast<double>(beta[i]) != waveguide_.beta()) waveguide_.setBeta(static_cast<double>(beta[i]));
+            followBow(beta[i]);
             const T vh = waveguide_.template beginSamplePacked<Torsion>();
             const JunctionResult<T> r = junction_.solveThermalModel(vh, speed[i], force[i], zEff_);
             waveguide_.template endSampleWith<Torsion>(r.force);

@@ -33,8 +33,9 @@ template <typename T>
 inline Pack4<T> load4Narrow(const T* p) noexcept
 {
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-    // Empty asm statements: the compiler may neither reuse a wide load of the same address
-    // (the pointer is opaque to it) nor merge the four loads back into one (nor are the values).
+    // Empty asm statements: the pointer is opaque to the compiler, so it cannot reuse a wide
+    // load of the same address, and so are the loaded values, so it cannot merge the four
+    // loads back into one.
     asm("" : "+r"(p));
     T a = p[0], b = p[1], c = p[2], d = p[3];
     asm("" : "+x"(a), "+x"(b), "+x"(c), "+x"(d));

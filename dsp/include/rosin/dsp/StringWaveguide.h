@@ -256,10 +256,33 @@ public:
     /// then calls beginSamplePacked<torsion>() itself and skips the per-sample dispatch.
     bool packed() const noexcept { return plain_; }
 
-private:
-    template <typename>
-    friend class BowedString;
+    /// The plain string (one-pole losses, no dispersion, no touched harmonic; torsion on or off),
+    /// which is what a playing voice runs: the four lossy reflections are four lanes of one
+    /// pack, read (four 4-point stencils), summed and filtered together. Same equations as the
+    /// general path, summed in a different order. Only for a packed() string: beginSample()
+    /// dispatches here, a voice's inner loop calls it directly with torsion fixed.
+    template <bool Torsion>
+    T beginSamplePacked() noexcept
+    {
+        const Pack4 reads = simd::sumEach<T>(loadStencil(bridgeOut_, tapBridgeOut_) * weightsBridgeOut_,
+                                             loadStencil(fingerSide_, tapFinger_) * weightsFinger_,
+                                             loadStencil(torsionBridge_, tapTorsionBridge_) * weightsTorsionBridge_,
+                                             loadStencil(torsionFinger_, tapTorsionFinger_) * weightsTorsionFinger_);
+        const Pack4 filtered = lossB0_ * reads - lossA1_ * lossState_;
+        lossState_ = filtered;
+        const T arriving = reads[kBridge];
+        bridgeForce_ = static_cast<T>(z0_) * (arriving + filtered[kBridge]);
+        u1In_ = bridgeBack_.read(tapBridgeBack_);
+        bridgeBack_.write(-filtered[kBridge]);
+        u2In_ = -filtered[kFinger];
+        if (Torsion) { // the torsional lines are silent otherwise; their lanes are ignored
+            u1tIn_ = -filtered[kTorsionBridge];
+            u2tIn_ = -filtered[kTorsionFinger];
+        }
+        return u1In_ + u2In_ + u1tIn_ + u2tIn_;
+    }
 
+private:
     typedef simd::Pack4<T> Pack4;
     /// Lanes of the four lossy reflections: the waves arriving at the bridge and at the finger,
     /// transverse and torsional.
@@ -286,31 +309,6 @@ private:
     /// Stencils whose newest sample is younger than this read narrow. Measured: the torsional
     /// bridge side (newest sample 1-3 back) paid the wait; the bridge side at 4 did not.
     static constexpr std::size_t kRecentSamples = 4;
-
-    /// The plain string (one-pole losses, no dispersion, no touched harmonic; torsion on or off),
-    /// which is what a playing voice runs: the four lossy reflections are four lanes of one
-    /// pack, read (four 4-point stencils), summed and filtered together. Same equations as the
-    /// general path, summed in a different order.
-    template <bool Torsion>
-    T beginSamplePacked() noexcept
-    {
-        const Pack4 reads = simd::sumEach<T>(loadStencil(bridgeOut_, tapBridgeOut_) * weightsBridgeOut_,
-                                             loadStencil(fingerSide_, tapFinger_) * weightsFinger_,
-                                             loadStencil(torsionBridge_, tapTorsionBridge_) * weightsTorsionBridge_,
-                                             loadStencil(torsionFinger_, tapTorsionFinger_) * weightsTorsionFinger_);
-        const Pack4 filtered = lossB0_ * reads - lossA1_ * lossState_;
-        lossState_ = filtered;
-        const T arriving = reads[kBridge];
-        bridgeForce_ = static_cast<T>(z0_) * (arriving + filtered[kBridge]);
-        u1In_ = bridgeBack_.read(tapBridgeBack_);
-        bridgeBack_.write(-filtered[kBridge]);
-        u2In_ = -filtered[kFinger];
-        if (Torsion) { // the torsional lines are silent otherwise; their lanes are ignored
-            u1tIn_ = -filtered[kTorsionBridge];
-            u2tIn_ = -filtered[kTorsionFinger];
-        }
-        return u1In_ + u2In_ + u1tIn_ + u2tIn_;
-    }
 
     void updatePlain() noexcept
     {
