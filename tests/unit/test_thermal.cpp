@@ -49,6 +49,64 @@ TYPED_TEST(ConductionBankTest, MovingSurfaceSteadyFluxIsSqrtKappa)
     }
 }
 
+// The renewal grid is a cache of the exact coefficients at its own kappa values: rounding a
+// kappa onto it moves it by at most 0.8 %, and the bank then behaves exactly (bit for bit) like
+// a bank without the grid given the grid value. Outside the grid kappa is taken as it is.
+TYPED_TEST(ConductionBankTest, RenewalGridIsTheExactBankAtTheNearestGridValue)
+{
+    ThermalParams tp;
+    const double fs = 48000.0;
+    ConductionBank<TypeParam> grid;
+    grid.prepare(fs, tp.xiMin, tp.xiMaxOverSampleRate * fs, tp.polesPerDecade, true);
+    ASSERT_LT(grid.renewalGridLow(), 1.0);
+    ASSERT_GT(grid.renewalGridHigh(), 1e6);
+    double worstOffset = 0.0, previous = 0.0;
+    int checked = 0;
+    for (double kappa = 0.3; kappa < 3e6; kappa *= 1.0123) {
+        grid.setKappa(kappa);
+        const double onGrid = grid.kappa();
+        worstOffset = std::max(worstOffset, std::abs(onGrid / kappa - 1.0));
+        EXPECT_GE(onGrid, previous) << "kappa=" << kappa; // rounding keeps the order
+        previous = onGrid;
+        if (++checked % 37 != 0) continue;
+        ConductionBank<TypeParam> exact;
+        exact.prepare(fs, tp.xiMin, tp.xiMaxOverSampleRate * fs, tp.polesPerDecade);
+        exact.setKappa(onGrid);
+        EXPECT_EQ(exact.gamma(), grid.gamma()) << "kappa=" << kappa;
+        ConductionBank<TypeParam> replay = grid; // the same states, then the same steps
+        replay.reset();
+        replay.setKappa(kappa);
+        for (int n = 0; n < 50; ++n) {
+            replay.advance(TypeParam(10 + n));
+            exact.advance(TypeParam(10 + n));
+        }
+        EXPECT_EQ(exact.history(), replay.history()) << "kappa=" << kappa;
+        EXPECT_EQ(exact.flux(3.0), replay.flux(3.0)) << "kappa=" << kappa;
+    }
+    EXPECT_GT(checked, 1000);
+    EXPECT_LT(worstOffset, 0.0079); // half of the widest spacing, 1/64 of an octave's start
+    EXPECT_GT(worstOffset, 0.003);  // and it really rounds
+    for (double outside : {0.1, 2e7}) {
+        grid.setKappa(outside);
+        EXPECT_EQ(grid.kappa(), outside);
+    }
+}
+
+// The grid's rounding costs nothing visible in the physics the bank is for.
+TYPED_TEST(ConductionBankTest, MovingSurfaceSteadyFluxIsSqrtKappaOnTheRenewalGrid)
+{
+    const double fs = 96000.0;
+    ThermalParams tp;
+    for (double kappa : {30.0, 300.0, 3000.0, 30000.0}) {
+        ConductionBank<TypeParam> bank;
+        bank.prepare(fs, tp.xiMin, tp.xiMaxOverSampleRate * fs, tp.polesPerDecade, true);
+        bank.setKappa(kappa);
+        const int n = static_cast<int>(std::max(0.05, 20.0 / kappa) * fs);
+        for (int i = 0; i < n; ++i) bank.advance(TypeParam(1));
+        EXPECT_NEAR(bank.flux(1.0) / std::sqrt(kappa), 1.0, 0.03) << "kappa=" << kappa;
+    }
+}
+
 // The inversion of steady sliding against the PHYSICS.md 3.5 reference table (same defaults).
 TEST(TemperatureLaw, InversionMatchesTheReferenceTable)
 {
@@ -254,7 +312,7 @@ TEST(ThermalContact, StepEqualsTheImplicitUpdateWrittenOut)
     contact.prepare(fs, p);
     ConductionBank<double> stringSide, rodSide;
     stringSide.prepare(fs, p.xiMin, p.xiMaxOverSampleRate * fs, p.polesPerDecade);
-    rodSide.prepare(fs, p.xiMin, p.xiMaxOverSampleRate * fs, p.polesPerDecade);
+    rodSide.prepare(fs, p.xiMin, p.xiMaxOverSampleRate * fs, p.polesPerDecade, true); // as the contact's rod side
     double theta = 0.0, hottest = 0.0;
     int stills = 0, moving = 0;
     for (int n = 0; n < 6000; ++n) {

@@ -8,8 +8,11 @@
 #pragma once
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <vector>
 
 #include "Config.h"
 #include "FrictionLaws.h"
@@ -26,7 +29,10 @@ public:
     /// integral the grid leaves out: below it, one pole at xi_lo/3 (matters for t ~ 1/xi_min);
     /// above it, s/(s+xi) ~ s/xi, i.e. an extra heat capacity 2/(pi sqrt(xi_hi)) (matters once
     /// kappa approaches xi_max).
-    void prepare(double sampleRate, double xiMin, double xiMax, double perDecade) noexcept
+    ///
+    /// renewalGrid: also tabulate the kappa-dependent sums on a fine grid of kappa (allocates;
+    /// see setKappa). Only a side whose surface moves needs it.
+    void prepare(double sampleRate, double xiMin, double xiMax, double perDecade, bool renewalGrid = false)
     {
         h_ = 1.0 / sampleRate;
         const double decades = std::log10(xiMax / xiMin);
@@ -51,9 +57,10 @@ public:
         for (int k = 0; k < N; ++k) {
             xiT_[k / kLanes][k % kLanes] = static_cast<T>(xi_[k]);
             weightT_[k / kLanes][k % kLanes] = static_cast<T>(weight_[k]);
-            weightXiT_[k / kLanes][k % kLanes] = static_cast<T>(weight_[k] * xi_[k]);
+            weightXiDecayT_[k / kLanes][k % kLanes] = static_cast<T>(weight_[k] * xi_[k] * baseDecay_[k]);
             baseDecayT_[k / kLanes][k % kLanes] = static_cast<T>(baseDecay_[k]);
         }
+        buildRenewalGrid(renewalGrid);
         kappa_ = -1.0;
         setKappa(0.0);
         reset();
@@ -71,36 +78,43 @@ public:
         setKappa(0.0);
     }
 
-    /// [audio thread] Surface-renewal rate (1/s). Coefficients are recomputed only when it moves
-    /// by more than 2 % (or to/from zero), which during sticking is never. True when they were.
+    /// [audio thread] Surface-renewal rate (1/s). True when the coefficients changed.
+    ///
+    /// With the renewal grid, a kappa inside it is rounded to the nearest grid value (at most
+    /// 0.8 % away) and the coefficients change only when that grid value does. Elsewhere (and
+    /// without the grid) they are recomputed only when kappa moves by more than 2 % (or to or
+    /// from zero), the tolerance of PHYSICS.md 3.4. During sticking neither ever happens.
     bool setKappa(double kappa) noexcept
     {
         if (kappa == kappa_) return false;
+        if (kappa >= gridLow_ && kappa < gridHigh_) {
+            const int index = gridIndex(kappa);
+            if (index == gridIndex_) return false;
+            // While slipping kappa follows the sliding speed, which follows this sample's
+            // temperature, so the next temperature waits for these coefficients. The grid turns
+            // the exponential and the sums over the poles into one table read on that path.
+            const RenewalEntry& e = renewal_[static_cast<std::size_t>(index)];
+            gridIndex_ = index;
+            kappa_ = e.kappa;
+            fillCoefficients<false>(e.kappa, e.decay);
+            gammaTotal_ = e.gamma;
+            historyGain_ = e.historyGain;
+            nextHistoryValid_ = false; // predicted with the old weights
+            return true;
+        }
         if (kappa > 0.0 && kappa_ > 0.0 && std::abs(kappa - kappa_) < 0.02 * kappa_) return false;
+        gridIndex_ = -1;
         kappa_ = kappa;
-        // Runs on most slipping samples: kept in T and in packs so it vectorises.
-        const T ek = static_cast<T>(std::exp(-kappa * h_)), kap = static_cast<T>(kappa);
-        Pack g{}, c{};
-        for (int p = 0; p < kPacks; ++p) {
-            const Pack eps = baseDecayT_[p] * ek;
-            const Pack b = (T(1) - eps) / (xiT_[p] + kap);
-            decay_[p] = eps;
-            gain_[p] = b;
-            historyWeight_[p] = weightXiT_[p] * eps;
-            historyDecay_[p] = historyWeight_[p] * eps;
-            g += weightT_[p] * (T(1) - xiT_[p] * b);
-            c += historyWeight_[p] * b;
-        }
-        double gamma = 0.0, gain = 0.0;
-        for (int j = 0; j < kLanes; ++j) {
-            gamma += static_cast<double>(g[j]);
-            gain += static_cast<double>(c[j]);
-        }
-        gammaTotal_ = gamma + tailCapacity_ * (1.0 / h_ + kappa);
-        historyGain_ = gain + tailRate_;
-        nextHistoryValid_ = false; // predicted with the old weights
+        fillCoefficients<true>(kappa, static_cast<T>(std::exp(-kappa * h_)));
+        nextHistoryValid_ = false;
         return true;
     }
+
+    /// The renewal rate the coefficients were computed for (a grid value when on the grid).
+    double kappa() const noexcept { return kappa_; }
+    /// Range of kappa (1/s) served by the renewal grid; empty without it.
+    double renewalGridLow() const noexcept { return gridLow_; }
+    double renewalGridHigh() const noexcept { return gridHigh_; }
 
     /// This step's flux (per unit area and effusivity) is gamma() * theta_new - history().
     double gamma() const noexcept { return gammaTotal_; }
@@ -109,11 +123,13 @@ public:
     double history() const noexcept { return nextHistoryValid_ ? nextHistory_ : recomputedHistory(); }
 
     /// The same, summed from the pole states now (what the prediction in advance() must equal).
+    /// The weights w xi eps carry kappa only through the common factor exp(-kappa h), applied
+    /// after the sum: the pole sum need not wait for a new kappa.
     double recomputedHistory() const noexcept
     {
-        Pack acc = historyWeight_[0] * z_[0];
-        for (int p = 1; p < packs_; ++p) acc += historyWeight_[p] * z_[p];
-        return static_cast<double>(sum(acc)) + tailRate_ * thetaPrev_;
+        Pack acc = weightXiDecayT_[0] * z_[0];
+        for (int p = 1; p < packs_; ++p) acc += weightXiDecayT_[p] * z_[p];
+        return static_cast<double>(sum(acc)) * static_cast<double>(renewalDecay_) + tailRate_ * thetaPrev_;
     }
 
     /// Commit the step with the new temperature.
@@ -142,6 +158,80 @@ public:
     int poleCount() const noexcept { return count_; }
 
 private:
+    /// Renewal grid: every float whose mantissa ends in 17 zero bits, i.e. 64 values per octave,
+    /// 0.8-1.6 % apart, from 1/4 to 2^24 per second (below, kappa is under the slowest poles'
+    /// rates; above, the contact would be a few microns wide). Rounding the float's bits finds
+    /// the nearest value without a logarithm.
+    static constexpr int kGridShift = 23 - 6;
+    static constexpr float kGridLow = 0.25f, kGridHigh = 16777216.0f;
+
+    struct RenewalEntry {
+        double kappa, gamma, historyGain;
+        T decay; // exp(-kappa h), as the coefficients take it
+    };
+
+    static int gridIndex(double kappa) noexcept
+    {
+        const std::uint32_t bits = std::bit_cast<std::uint32_t>(static_cast<float>(kappa));
+        const std::uint32_t low = std::bit_cast<std::uint32_t>(kGridLow) >> kGridShift;
+        return static_cast<int>(((bits + (1u << (kGridShift - 1))) >> kGridShift) - low);
+    }
+
+    void buildRenewalGrid(bool wanted)
+    {
+        renewal_.clear();
+        gridLow_ = gridHigh_ = 0.0; // empty range: setKappa never looks for the grid
+        gridIndex_ = -1;
+        if (!wanted) return;
+        const std::uint32_t low = std::bit_cast<std::uint32_t>(kGridLow) >> kGridShift;
+        const std::uint32_t high = std::bit_cast<std::uint32_t>(kGridHigh) >> kGridShift;
+        renewal_.reserve(high - low + 1);
+        for (std::uint32_t i = low; i <= high; ++i) {
+            RenewalEntry e{};
+            e.kappa = static_cast<double>(std::bit_cast<float>(i << kGridShift));
+            e.decay = static_cast<T>(std::exp(-e.kappa * h_));
+            fillCoefficients<true>(e.kappa, e.decay); // the same arithmetic as the exact path
+            e.gamma = gammaTotal_;
+            e.historyGain = historyGain_;
+            renewal_.push_back(e);
+        }
+        // Values that round onto the last entry stay inside; the top half-step falls back.
+        gridLow_ = static_cast<double>(kGridLow);
+        gridHigh_ = static_cast<double>(kGridHigh);
+    }
+
+    /// Pole coefficients for renewal rate kappa with ek = exp(-kappa h); WithSums also forms
+    /// gamma and the history gain (the grid has them tabulated).
+    template <bool WithSums>
+    void fillCoefficients(double kappa, T ek) noexcept
+    {
+        // Runs on most slipping samples: kept in T and in packs so it vectorises.
+        const T kap = static_cast<T>(kappa);
+        Pack g{}, c{};
+        for (int p = 0; p < kPacks; ++p) {
+            const Pack eps = baseDecayT_[p] * ek;
+            const Pack b = (T(1) - eps) / (xiT_[p] + kap);
+            decay_[p] = eps;
+            gain_[p] = b;
+            const Pack historyWeight = weightXiDecayT_[p] * ek;
+            historyDecay_[p] = historyWeight * eps;
+            if constexpr (WithSums) {
+                g += weightT_[p] * (T(1) - xiT_[p] * b);
+                c += historyWeight * b;
+            }
+        }
+        renewalDecay_ = ek;
+        if constexpr (WithSums) {
+            double gamma = 0.0, gain = 0.0;
+            for (int j = 0; j < kLanes; ++j) {
+                gamma += static_cast<double>(g[j]);
+                gain += static_cast<double>(c[j]);
+            }
+            gammaTotal_ = gamma + tailCapacity_ * (1.0 / h_ + kappa);
+            historyGain_ = gain + tailRate_;
+        }
+    }
+
     static constexpr int N = config::thermalPoleSlots;
     // 16-byte packs of T (GCC/Clang vector extension): 4 floats or 2 doubles per operation.
     typedef T Pack __attribute__((vector_size(16)));
@@ -178,26 +268,29 @@ private:
     double h_ = 1.0 / 48000.0, kappa_ = -1.0, gammaTotal_ = 0.0, tailCapacity_ = 0.0, tailRate_ = 0.0, thetaPrev_ = 0.0;
     double historyGain_ = 0.0, nextHistory_ = 0.0;
     bool nextHistoryValid_ = true;
-    int count_ = 0, packs_ = kPacks;
+    int count_ = 0, packs_ = kPacks, gridIndex_ = -1;
+    double gridLow_ = 0.0, gridHigh_ = 0.0;
+    std::vector<RenewalEntry> renewal_;
     std::array<double, N> xi_{}, weight_{}, baseDecay_{};
     // Plain arrays: GCC drops the vector attribute of Pack inside std::array<Pack, ...>.
-    Pack z_[kPacks]{}, decay_[kPacks]{}, gain_[kPacks]{}, historyWeight_[kPacks]{}, historyDecay_[kPacks]{};
-    Pack xiT_[kPacks]{}, weightT_[kPacks]{}, weightXiT_[kPacks]{}, baseDecayT_[kPacks]{};
+    Pack z_[kPacks]{}, decay_[kPacks]{}, gain_[kPacks]{}, historyDecay_[kPacks]{};
+    Pack xiT_[kPacks]{}, weightT_[kPacks]{}, weightXiDecayT_[kPacks]{}, baseDecayT_[kPacks]{};
+    T renewalDecay_ = T(1); // exp(-kappa h) of the coefficients in use
 };
 
 /// Contact temperature rise theta (K above ambient) driven by frictional heating.
 template <typename T>
 class ThermalContact {
 public:
-    /// [setup thread]
-    void prepare(double sampleRate, const ThermalParams& params) noexcept
+    /// [setup thread] Allocates (the rod side's renewal grid).
+    void prepare(double sampleRate, const ThermalParams& params)
     {
         params_ = params;
         h_ = 1.0 / sampleRate;
         rate_ = sampleRate;
         const double xiMax = params.xiMaxOverSampleRate * sampleRate;
         stringSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade);
-        rodSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade);
+        rodSide_.prepare(sampleRate, params.xiMin, xiMax, params.polesPerDecade, true);
         areaCached_ = -1.0; // the per-area terms depend on the parameters just set
         reset();
     }
