@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 
 #include "Config.h"
@@ -153,6 +154,23 @@ public:
         return solveThermal(s.history, s.bow);
     }
 
+    /// Bow force and speed of a block made safe as solve() makes them (non-finite -> 0, then
+    /// clamped), in one pass the compiler vectorises, for solveThermalCleanControls().
+    static void cleanControls(const T* force, const T* speed, T* forceOut, T* speedOut, int n) noexcept
+    {
+        for (int i = 0; i < n; ++i) {
+            forceOut[i] = cleanForce(force[i]);
+            speedOut[i] = cleanSpeed(speed[i]);
+        }
+    }
+
+    /// solveThermalModel() for controls already passed through cleanControls().
+    [[gnu::always_inline]] JunctionResult<T> solveThermalCleanControls(T vhIn, T vb, T fb, double zEff) noexcept
+    {
+        updateLoadLine(static_cast<double>(fb), zEff);
+        return solveThermal(finiteOr(vhIn), static_cast<double>(vb));
+    }
+
     /// Largest friction force the contact can hold without slipping at temperature theta and
     /// bow force fb (the stick limit), for tests and diagnostics.
     double stickLimit(double fb, double theta) const noexcept
@@ -206,6 +224,18 @@ private:
     }
 
     static double finiteOr(T x) noexcept { return std::isfinite(static_cast<double>(x)) ? static_cast<double>(x) : 0.0; }
+
+    /// Non-finite -> 0, then clamped. Done in T: the limits are exact in float, so this equals
+    /// clamping the double, and a block of it vectorises.
+    static T cleanControl(T x, T lo, T hi) noexcept
+    {
+        return std::abs(x) <= std::numeric_limits<T>::max() ? std::clamp(x, lo, hi) : T(0);
+    }
+    static T cleanForce(T x) noexcept { return cleanControl(x, T(0), static_cast<T>(config::maxBowForce)); }
+    static T cleanSpeed(T x) noexcept
+    {
+        return cleanControl(x, static_cast<T>(-config::maxBowSpeed), static_cast<T>(config::maxBowSpeed));
+    }
 
     /// Friction-curve and enhanced models: mu(x) = scale * law(x) falls with sliding speed, so
     /// the load line may cut it three times; the McIntyre-Woodhouse hysteresis rule picks one.
@@ -280,8 +310,8 @@ private:
     /// force and impedance. Returns v_h and v_b.
     Speeds takeInputs(T vhIn, T vbIn, T fbIn, double zEff) noexcept
     {
-        updateLoadLine(std::clamp(finiteOr(fbIn), 0.0, config::maxBowForce), zEff);
-        return {finiteOr(vhIn), std::clamp(finiteOr(vbIn), -config::maxBowSpeed, config::maxBowSpeed)};
+        updateLoadLine(static_cast<double>(cleanForce(fbIn)), zEff);
+        return {finiteOr(vhIn), static_cast<double>(cleanSpeed(vbIn))};
     }
 
     void updateLoadLine(double fb, double zEff) noexcept

@@ -1,5 +1,6 @@
 // One bowed string: waveguide + bow junction, driven by physical controls every sample.
 #pragma once
+#include <algorithm>
 #include <cmath>
 
 #include "BowJunction.h"
@@ -107,12 +108,19 @@ private:
     template <bool Torsion>
     ROSIN_VOICE_CLONES void processPlainThermal(const T* force, const T* speed, const T* beta, T* out, int n) noexcept
     {
-        for (int i = 0; i < n; ++i) {
-            followBow(beta[i]);
-            const T vh = waveguide_.template beginSamplePacked<Torsion>();
-            const JunctionResult<T> r = junction_.solveThermalModel(vh, speed[i], force[i], zEff_);
-            waveguide_.template endSampleWith<Torsion>(r.force);
-            out[i] = waveguide_.bridgeForce();
+        // The controls are made safe a chunk at a time in one vectorised pass, not per sample.
+        constexpr int kChunk = 64;
+        T forceClean[kChunk], speedClean[kChunk];
+        for (int start = 0; start < n; start += kChunk) {
+            const int m = std::min(kChunk, n - start);
+            BowJunction<T>::cleanControls(force + start, speed + start, forceClean, speedClean, m);
+            for (int j = 0; j < m; ++j) {
+                followBow(beta[start + j]);
+                const T vh = waveguide_.template beginSamplePacked<Torsion>();
+                const JunctionResult<T> r = junction_.solveThermalCleanControls(vh, speedClean[j], forceClean[j], zEff_);
+                waveguide_.template endSampleWith<Torsion>(r.force);
+                out[start + j] = waveguide_.bridgeForce();
+            }
         }
     }
 

@@ -57,8 +57,7 @@ public:
         const double ratio = std::clamp(options.lowestPitchRatio, 0.05, 1.0);
         const double period = fs_ / (f0_ * ratio);
         lowestFundamental_ = f0_ * ratio;
-        for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_, &nodeBack_, &nodeRound_})
-            line->prepare(period / std::min(1.0, params.torsionSpeedRatio) + 16.0);
+        lines_.prepare(kLineCount, period / std::min(1.0, params.torsionSpeedRatio) + 16.0);
         harmonic_ = 0;
         designDispersion();
         updatePlain();
@@ -69,8 +68,7 @@ public:
 
     void reset() noexcept
     {
-        for (auto* line : {&bridgeOut_, &bridgeBack_, &fingerSide_, &torsionBridge_, &torsionFinger_, &nodeBack_, &nodeRound_})
-            line->reset();
+        lines_.reset();
         lossState_ = Pack4{};
         dispersion_.reset();
         u1In_ = u2In_ = u1tIn_ = u2tIn_ = T(0);
@@ -104,6 +102,10 @@ public:
         n = n >= 2 && n <= 16 ? n : 0;
         const double r = std::clamp(std::isfinite(damping) ? damping : 1.0, 0.01, 100.0);
         if (n == harmonic_ && r == nodeDamping_) return;
+        if (harmonic_ == 0 && n > 0) { // the node lines sat unwritten: start them silent
+            lines_.clear(kNodeBackLine);
+            lines_.clear(kNodeRoundLine);
+        }
         harmonic_ = n;
         nodeDamping_ = r;
         designNode();
@@ -132,13 +134,13 @@ public:
         designLoss(lossTorsionFinger_, tau2t, true);
         delayTorsionBridge_ = tau1t * fs_ - lossTorsionBridge_.phaseDelay(w0_);
         delayTorsionFinger_ = tau2t * fs_ - lossTorsionFinger_.phaseDelay(w0_);
-        tapBridgeOut_ = bridgeOut_.tap(delayBridgeOut_);
-        tapBridgeBack_ = bridgeBack_.tap(delayBridgeBack_);
-        tapFinger_ = fingerSide_.tap(delayFinger_);
-        tapTorsionBridge_ = torsionBridge_.tap(delayTorsionBridge_);
-        tapTorsionFinger_ = torsionFinger_.tap(delayTorsionFinger_);
+        tapBridgeOut_ = lines_.tap(kBridgeOutLine, delayBridgeOut_);
+        tapBridgeBack_ = lines_.tap(kBridgeBackLine, delayBridgeBack_);
+        tapFinger_ = lines_.tap(kFingerLine, delayFinger_);
+        tapTorsionBridge_ = lines_.tap(kTorsionBridgeLine, delayTorsionBridge_);
+        tapTorsionFinger_ = lines_.tap(kTorsionFingerLine, delayTorsionFinger_);
         // One way, bow to finger, read after this sample's write: one sample further back.
-        tapFarEnd_ = fingerSide_.tap(0.5 * tau2 * fs_ + 1.0);
+        tapFarEnd_ = lines_.tap(kFingerLine, 0.5 * tau2 * fs_ + 1.0);
         const OnePoleLoss<T>* loss[4] = {&lossBridge_, &lossFinger_, &lossTorsionBridge_, &lossTorsionFinger_};
         for (int k = 0; k < 4; ++k) {
             lossB0_[k] = loss[k]->b0;
@@ -170,26 +172,26 @@ public:
     T beginSample() noexcept
     {
         if (plain_) return options_.torsion ? beginSamplePacked<true>() : beginSamplePacked<false>();
-        const T arriving = bridgeOut_.read(tapBridgeOut_);
+        const T arriving = lines_.read(tapBridgeOut_);
         const T reflected = -loss(kBridge, arriving);
         bridgeForce_ = static_cast<T>(z0_) * (arriving - reflected);
         if (options_.gaussianReflections) return beginSampleGaussian(arriving);
-        u1In_ = bridgeBack_.read(tapBridgeBack_);
-        bridgeBack_.write(reflected);
+        u1In_ = lines_.read(tapBridgeBack_);
+        lines_.write(kBridgeBackLine, reflected);
         if (harmonic_ > 0) {
             // Finger side split at the touched node: bow <-> node (A), node <-> finger end (B).
-            const T aIn = fingerSide_.read(tapNodeA_);
-            const T bIn = -loss(kFinger, dispersion_.process(nodeRound_.read(tapNodeRound_)));
+            const T aIn = lines_.read(tapNodeA_);
+            const T bIn = -loss(kFinger, dispersion_.process(lines_.read(tapNodeRound_)));
             const T v = nodeGain_ * (aIn + bIn); // 2Z (a + b) / (2Z + R)
-            u2In_ = nodeBack_.read(tapNodeBack_);
-            nodeBack_.write(v - aIn);
-            nodeRound_.write(v - bIn);
+            u2In_ = lines_.read(tapNodeBack_);
+            lines_.write(kNodeBackLine, v - aIn);
+            lines_.write(kNodeRoundLine, v - bIn);
         } else {
-            u2In_ = -loss(kFinger, dispersion_.process(fingerSide_.read(tapFinger_)));
+            u2In_ = -loss(kFinger, dispersion_.process(lines_.read(tapFinger_)));
         }
         if (options_.torsion) {
-            u1tIn_ = -loss(kTorsionBridge, torsionBridge_.read(tapTorsionBridge_));
-            u2tIn_ = -loss(kTorsionFinger, torsionFinger_.read(tapTorsionFinger_));
+            u1tIn_ = -loss(kTorsionBridge, lines_.read(tapTorsionBridge_));
+            u2tIn_ = -loss(kTorsionFinger, lines_.read(tapTorsionFinger_));
         }
         return u1In_ + u2In_ + u1tIn_ + u2tIn_;
     }
@@ -202,13 +204,14 @@ public:
     void endSampleWith(T f) noexcept
     {
         const T dv = f * halfAdmittance_;
-        bridgeOut_.write(u2In_ + dv);
-        fingerSide_.write(u1In_ + dv);
+        lines_.write(kBridgeOutLine, u2In_ + dv);
+        lines_.write(kFingerLine, u1In_ + dv);
         if (Torsion) {
             const T dvt = f * halfTorsionAdmittance_;
-            torsionBridge_.write(u2tIn_ + dvt);
-            torsionFinger_.write(u1tIn_ + dvt);
+            lines_.write(kTorsionBridgeLine, u2tIn_ + dvt);
+            lines_.write(kTorsionFingerLine, u1tIn_ + dvt);
         }
+        lines_.advance(); // every line written this sample moves on together
     }
 
     /// Force of the string on the bridge for the current sample (valid after beginSample).
@@ -216,7 +219,7 @@ public:
     /// Force on the far (finger or nut) end for the sample just completed (call after
     /// endSample), for two-ended measurements (PHYSICS.md 7.2): twice Z0 times the wave
     /// arriving there, signed like the bridge force. Read on demand: a voice never needs it.
-    T farEndForce() const noexcept { return static_cast<T>(2.0 * z0_) * fingerSide_.read(tapFarEnd_); }
+    T farEndForce() const noexcept { return static_cast<T>(2.0 * z0_) * lines_.read(tapFarEnd_); }
 
     /// Transverse part of the history velocity (what the bow would see with torsion ignored).
     T transverseHistory() const noexcept { return u1In_ + u2In_; }
@@ -239,12 +242,12 @@ public:
     {
         const double h = 1.0 / fs_;
         auto count = [](double d) { return static_cast<std::size_t>(std::ceil(d - 1e-9)); };
-        double e = z0_ * (bridgeOut_.sumOfSquares(count(delayBridgeOut_))
-                          + bridgeBack_.sumOfSquares(count(delayBridgeBack_))
-                          + fingerSide_.sumOfSquares(count(delayFinger_)));
+        double e = z0_ * (lines_.sumOfSquares(kBridgeOutLine, count(delayBridgeOut_))
+                          + lines_.sumOfSquares(kBridgeBackLine, count(delayBridgeBack_))
+                          + lines_.sumOfSquares(kFingerLine, count(delayFinger_)));
         if (options_.torsion)
-            e += zt_ * (torsionBridge_.sumOfSquares(count(delayTorsionBridge_))
-                        + torsionFinger_.sumOfSquares(count(delayTorsionFinger_)));
+            e += zt_ * (lines_.sumOfSquares(kTorsionBridgeLine, count(delayTorsionBridge_))
+                        + lines_.sumOfSquares(kTorsionFingerLine, count(delayTorsionFinger_)));
         return e * h;
     }
 
@@ -264,16 +267,16 @@ public:
     template <bool Torsion>
     T beginSamplePacked() noexcept
     {
-        const Pack4 reads = simd::sumEach<T>(loadStencil(bridgeOut_, tapBridgeOut_) * weightsBridgeOut_,
-                                             loadStencil(fingerSide_, tapFinger_) * weightsFinger_,
-                                             loadStencil(torsionBridge_, tapTorsionBridge_) * weightsTorsionBridge_,
-                                             loadStencil(torsionFinger_, tapTorsionFinger_) * weightsTorsionFinger_);
+        const Pack4 reads = simd::sumEach<T>(loadStencil(tapBridgeOut_) * weightsBridgeOut_,
+                                             loadStencil(tapFinger_) * weightsFinger_,
+                                             loadStencil(tapTorsionBridge_) * weightsTorsionBridge_,
+                                             loadStencil(tapTorsionFinger_) * weightsTorsionFinger_);
         const Pack4 filtered = lossB0_ * reads - lossA1_ * lossState_;
         lossState_ = filtered;
         const T arriving = reads[kBridge];
         bridgeForce_ = static_cast<T>(z0_) * (arriving + filtered[kBridge]);
-        u1In_ = bridgeBack_.read(tapBridgeBack_);
-        bridgeBack_.write(-filtered[kBridge]);
+        u1In_ = lines_.read(tapBridgeBack_);
+        lines_.write(kBridgeBackLine, -filtered[kBridge]);
         u2In_ = -filtered[kFinger];
         if (Torsion) { // the torsional lines are silent otherwise; their lanes are ignored
             u1tIn_ = -filtered[kTorsionBridge];
@@ -287,6 +290,14 @@ private:
     /// Lanes of the four lossy reflections: the waves arriving at the bridge and at the finger,
     /// transverse and torsional.
     static constexpr int kBridge = 0, kFinger = 1, kTorsionBridge = 2, kTorsionFinger = 3;
+    /// The delay lines, all one size and advanced together at the end of each sample: the two
+    /// halves of the bridge side, the finger side, the torsional sides, and the two pieces of
+    /// the finger side a touched harmonic splits off.
+    enum Line : int {
+        kBridgeOutLine, kBridgeBackLine, kFingerLine, kTorsionBridgeLine, kTorsionFingerLine, kNodeBackLine, kNodeRoundLine,
+        kLineCount
+    };
+    using Tap = typename DelayLines<T>::Tap;
 
     /// One-pole loss of one reflection (its lane of the packed filter state).
     T loss(int lane, T x) noexcept
@@ -296,14 +307,14 @@ private:
         return y;
     }
 
-    static Pack4 stencilWeights(const typename DelayLine<T>::Tap& t) noexcept { return Pack4{t.h3, t.h2, t.h1, t.h0}; }
+    static Pack4 stencilWeights(const Tap& t) noexcept { return Pack4{t.h3, t.h2, t.h1, t.h0}; }
 
     /// A tap's four samples. Short delays read narrow (see simd::load4Narrow): a line a few
     /// samples long reads what the last samples wrote. The branch follows the bow position,
     /// so it is predicted.
-    static Pack4 loadStencil(const DelayLine<T>& line, const typename DelayLine<T>::Tap& t) noexcept
+    Pack4 loadStencil(const Tap& t) const noexcept
     {
-        const T* p = line.stencil(t);
+        const T* p = lines_.stencil(t);
         return t.base < kRecentSamples ? simd::load4Narrow(p) : simd::load4(p);
     }
     /// Stencils whose newest sample is younger than this read narrow. Measured: the torsional
@@ -320,12 +331,12 @@ private:
     T beginSampleGaussian(T arriving) noexcept
     {
         bridgeForce_ = static_cast<T>(2.0 * z0_) * arriving;
-        u1In_ = -bridgeBack_.readKernel(gaussBridge_.first, gaussBridge_.weights, gaussBridge_.taps);
-        bridgeBack_.write(arriving);
-        u2In_ = -fingerSide_.readKernel(gaussFinger_.first, gaussFinger_.weights, gaussFinger_.taps);
+        u1In_ = -lines_.readKernel(kBridgeBackLine, gaussBridge_.first, gaussBridge_.weights, gaussBridge_.taps);
+        lines_.write(kBridgeBackLine, arriving);
+        u2In_ = -lines_.readKernel(kFingerLine, gaussFinger_.first, gaussFinger_.weights, gaussFinger_.taps);
         if (options_.torsion) {
-            u1tIn_ = -torsionBridge_.readKernel(gaussTorsionBridge_.first, gaussTorsionBridge_.weights, gaussTorsionBridge_.taps);
-            u2tIn_ = -torsionFinger_.readKernel(gaussTorsionFinger_.first, gaussTorsionFinger_.weights, gaussTorsionFinger_.taps);
+            u1tIn_ = -lines_.readKernel(kTorsionBridgeLine, gaussTorsionBridge_.first, gaussTorsionBridge_.weights, gaussTorsionBridge_.taps);
+            u2tIn_ = -lines_.readKernel(kTorsionFingerLine, gaussTorsionFinger_.first, gaussTorsionFinger_.weights, gaussTorsionFinger_.taps);
         }
         return u1In_ + u2In_ + u1tIn_ + u2tIn_;
     }
@@ -348,9 +359,9 @@ private:
         const double beyond = L / harmonic_;
         const double delayA = fromBow / c * fs_;
         const double delayB = 2.0 * beyond / c * fs_ - lossFinger_.phaseDelay(w0_) - dispersion_.phaseDelay(w0_);
-        tapNodeA_ = fingerSide_.tap(delayA);
-        tapNodeBack_ = nodeBack_.tap(delayA);
-        tapNodeRound_ = nodeRound_.tap(std::max(delayB, config::minSegmentDelay));
+        tapNodeA_ = lines_.tap(kFingerLine, delayA);
+        tapNodeBack_ = lines_.tap(kNodeBackLine, delayA);
+        tapNodeRound_ = lines_.tap(kNodeRoundLine, std::max(delayB, config::minSegmentDelay));
         nodeGain_ = static_cast<T>(2.0 / (2.0 + nodeDamping_));
     }
 
@@ -391,7 +402,7 @@ private:
     double z0_ = 0.5, zt_ = 1.0, beta_ = -1.0, lowestFundamental_ = 20.0;
     StringParams params_;
     WaveguideOptions options_;
-    DelayLine<T> bridgeOut_, bridgeBack_, fingerSide_, torsionBridge_, torsionFinger_, nodeBack_, nodeRound_;
+    DelayLines<T> lines_;
     int harmonic_ = 0;
     double nodeDamping_ = 1.0;
     T nodeGain_ = T(1), halfAdmittance_ = T(1), halfTorsionAdmittance_ = T(1);
@@ -402,8 +413,8 @@ private:
     DispersionChain<T> dispersion_;
     GaussianReflection<T> gaussBridge_, gaussFinger_, gaussTorsionBridge_, gaussTorsionFinger_;
     double delayBridgeOut_ = 1, delayBridgeBack_ = 1, delayFinger_ = 1, delayTorsionBridge_ = 1, delayTorsionFinger_ = 1;
-    typename DelayLine<T>::Tap tapBridgeOut_, tapBridgeBack_, tapFinger_, tapTorsionBridge_, tapTorsionFinger_, tapFarEnd_;
-    typename DelayLine<T>::Tap tapNodeA_, tapNodeBack_, tapNodeRound_;
+    Tap tapBridgeOut_, tapBridgeBack_, tapFinger_, tapTorsionBridge_, tapTorsionFinger_, tapFarEnd_;
+    Tap tapNodeA_, tapNodeBack_, tapNodeRound_;
     T u1In_ = T(0), u2In_ = T(0), u1tIn_ = T(0), u2tIn_ = T(0), bridgeForce_ = T(0);
 };
 
