@@ -416,7 +416,11 @@ TEST(EngineViewTap, WhenTheWatchedNoteEndsTheViewsFollowOneStillSounding)
     const std::size_t got = ring.read(frames.data(), frames.size());
     ASSERT_GT(got, 90000u);
     EXPECT_NEAR(frames[100].frequency, 196.0, 3.0);
-    EXPECT_NEAR(frames[10000].frequency, 587.3, 6.0);
+    // The frame shows the D, not the G. Its frequency is the stopped string's, which the ear's
+    // intonation correction may move by -50..+100 cents (listen() in Synth.cpp); this D5
+    // double-slips at times, so the correction wanders inside that range.
+    EXPECT_GE(frames[10000].frequency, 587.3 * std::exp2(-50.0 / 1200.0));
+    EXPECT_LE(frames[10000].frequency, 587.3 * std::exp2(100.0 / 1200.0));
     EXPECT_NEAR(frames[got - 1].frequency, 196.0, 3.0);
     int starts = 0;
     for (std::size_t i = 0; i < got; ++i) starts += frames[i].noteStart;

@@ -58,7 +58,13 @@ for q in 0 1 2 3; do
   colours=$(convert "$out/standalone-playing.png" -crop "$crop" +repage -format "%k" info:)
   before=$(convert "$out/standalone-before.png" -crop "$crop" +repage -format "%k" info:)
   echo "view $q: $colours colours while playing ($before before)"
-  if [ "$colours" -lt 40 ] || [ "$colours" -le "$before" ]; then echo "FAIL: view $q shows no signal"; fail=1; fi
+  if [ "$q" -eq 3 ]; then
+    # The Schelleng map is drawn before any note (for the selected string), so its colour count
+    # says nothing: while playing it must be redrawn for the note, with the player's marker.
+    changed=$(compare -metric AE -fuzz 5% "$out/standalone-before.png" "$out/standalone-playing.png" -crop "$crop" null: 2>&1 || true)
+    echo "view 3: $changed pixels differ from before"
+    if [ "$colours" -lt 40 ] || [ "${changed%%.*}" -lt 500 ]; then echo "FAIL: view 3 does not follow the note"; fail=1; fi
+  elif [ "$colours" -lt 40 ] || [ "$colours" -le "$before" ]; then echo "FAIL: view $q shows no signal"; fail=1; fi
 done
 moved=$(compare -metric AE -crop "${vw}x${vh}+${vx}+${vy}" "$out/standalone-playing.png" "$out/standalone-playing-later.png" null: 2>&1 || true)
 echo "pixels changed in the views in 0.4 s: $moved"

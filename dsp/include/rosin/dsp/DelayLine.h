@@ -108,7 +108,10 @@ public:
     }
 
     /// The four samples a tap weighs, oldest first: p[0] is delay base + 3, p[3] delay base.
-    const T* stencil(const Tap& t) const noexcept { return buffer_.data() + writeIndex_ + t.offset; }
+    const T* stencil(const Tap& t) const noexcept { return origin() + t.offset; }
+    /// Where this sample's taps count from: stencil(t) is origin() + t.offset for every line
+    /// (a caller reading several taps in one sample can take it once).
+    const T* origin() const noexcept { return buffer_.data() + writeIndex_; }
 
     /// This sample's value of `line`; advance() once all lines are written.
     void write(int line, T value) noexcept

@@ -267,10 +267,11 @@ public:
     template <bool Torsion>
     T beginSamplePacked() noexcept
     {
-        const Pack4 reads = simd::sumEach<T>(loadStencil(tapBridgeOut_) * weightsBridgeOut_,
-                                             loadStencil(tapFinger_) * weightsFinger_,
-                                             loadStencil(tapTorsionBridge_) * weightsTorsionBridge_,
-                                             loadStencil(tapTorsionFinger_) * weightsTorsionFinger_);
+        const T* origin = lines_.origin();
+        const Pack4 reads = simd::sumEach<T>(loadStencil(origin, tapBridgeOut_) * weightsBridgeOut_,
+                                             loadStencil(origin, tapFinger_) * weightsFinger_,
+                                             loadStencil(origin, tapTorsionBridge_) * weightsTorsionBridge_,
+                                             loadStencil(origin, tapTorsionFinger_) * weightsTorsionFinger_);
         const Pack4 filtered = lossB0_ * reads - lossA1_ * lossState_;
         lossState_ = filtered;
         const T arriving = reads[kBridge];
@@ -312,9 +313,9 @@ private:
     /// A tap's four samples. Short delays read narrow (see simd::load4Narrow): a line a few
     /// samples long reads what the last samples wrote. The branch follows the bow position,
     /// so it is predicted.
-    Pack4 loadStencil(const Tap& t) const noexcept
+    static Pack4 loadStencil(const T* origin, const Tap& t) noexcept
     {
-        const T* p = lines_.stencil(t);
+        const T* p = origin + t.offset;
         return t.base < kRecentSamples ? simd::load4Narrow(p) : simd::load4(p);
     }
     /// Stencils whose newest sample is younger than this read narrow. Measured: the torsional

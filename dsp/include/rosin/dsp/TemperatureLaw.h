@@ -65,6 +65,8 @@ public:
         invStep_ = 1.0 / step_;
         lastIndex_ = static_cast<double>(m - 1);
         tableLast_ = table_.back();
+        segments_.assign(m - 1, Segment{});
+        for (int i = 0; i + 1 < m; ++i) segments_[i] = {table_[i], table_[i + 1] - table_[i]};
         built_ = true;
     }
 
@@ -76,13 +78,12 @@ public:
     MuSlope at(double theta) const noexcept
     {
         const double x = (theta + shift_) * invStep_;
-        const double* t = table_.data();
-        if (!(x >= 0.0)) return {scale_ * t[0], 0.0};
+        if (!(x >= 0.0)) return {scale_ * table_[0], 0.0};
         if (x >= lastIndex_) return {scale_ * tableLast_, 0.0};
         const auto i = static_cast<std::size_t>(x);
         const double s = x - static_cast<double>(i);
-        const double d = t[i + 1] - t[i];
-        return {scale_ * (t[i] + s * d), scale_ * d * invStep_};
+        const Segment& g = segments_[i]; // one read: a slipping sample's next temperature waits for it
+        return {scale_ * (g.start + s * g.rise), scale_ * g.rise * invStep_};
     }
 
     /// d/d(theta) of operator(), one-sided on the table grid (0 where the law is clamped).
@@ -114,7 +115,11 @@ private:
         return speed ? mu / (*speed)(v).mu : mu;
     }
 
+    struct Segment {
+        double start, rise; // table_[i] and table_[i + 1] - table_[i]
+    };
     std::vector<double> table_{1.0, 1.0};
+    std::vector<Segment> segments_{{1.0, 0.0}};
     bool built_ = false;
     double step_ = 1.0, invStep_ = 1.0, thetaMax_ = 1.0, shift_ = 0.0, scale_ = 1.0;
     double lastIndex_ = 1.0, tableLast_ = 1.0; // the clamp at() tests every sample, kept at hand
