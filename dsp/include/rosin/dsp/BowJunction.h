@@ -146,14 +146,6 @@ public:
         return solveSpeedDependent(s.history, s.bow);
     }
 
-    /// solve() for a junction known to run the thermal model (a voice's inner loop checks the
-    /// model once per block instead of every sample).
-    [[gnu::always_inline]] JunctionResult<T> solveThermalModel(T vhIn, T vbIn, T fbIn, double zEff) noexcept
-    {
-        const Speeds s = takeInputs(vhIn, vbIn, fbIn, zEff);
-        return solveThermal(s.history, s.bow);
-    }
-
     /// Bow force and speed of a block made safe as solve() makes them (non-finite -> 0, then
     /// clamped), in one pass the compiler vectorises, for solveThermalCleanControls().
     static void cleanControls(const T* force, const T* speed, T* forceOut, T* speedOut, int n) noexcept
@@ -164,7 +156,9 @@ public:
         }
     }
 
-    /// solveThermalModel() for controls already passed through cleanControls().
+    /// solve() for a junction known to run the thermal model (a voice's inner loop checks the
+    /// model once per block instead of every sample), with controls already passed through
+    /// cleanControls().
     [[gnu::always_inline]] JunctionResult<T> solveThermalCleanControls(T vhIn, T vb, T fb, double zEff) noexcept
     {
         updateLoadLine(static_cast<double>(fb), zEff);

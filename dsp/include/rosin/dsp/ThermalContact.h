@@ -164,6 +164,9 @@ private:
     /// the nearest value without a logarithm.
     static constexpr int kGridShift = 23 - 6;
     static constexpr float kGridLow = 0.25f, kGridHigh = 16777216.0f;
+    /// The grid's ends as bit patterns shifted down: entry i is the float with bits (first + i) << shift.
+    static constexpr std::uint32_t kGridFirst = std::bit_cast<std::uint32_t>(kGridLow) >> kGridShift;
+    static constexpr std::uint32_t kGridLast = std::bit_cast<std::uint32_t>(kGridHigh) >> kGridShift;
 
     struct RenewalEntry {
         double kappa, gamma, historyGain;
@@ -173,8 +176,7 @@ private:
     static int gridIndex(double kappa) noexcept
     {
         const std::uint32_t bits = std::bit_cast<std::uint32_t>(static_cast<float>(kappa));
-        const std::uint32_t low = std::bit_cast<std::uint32_t>(kGridLow) >> kGridShift;
-        return static_cast<int>(((bits + (1u << (kGridShift - 1))) >> kGridShift) - low);
+        return static_cast<int>(((bits + (1u << (kGridShift - 1))) >> kGridShift) - kGridFirst);
     }
 
     void buildRenewalGrid(bool wanted)
@@ -183,10 +185,8 @@ private:
         gridLow_ = gridHigh_ = 0.0; // empty range: setKappa never looks for the grid
         gridIndex_ = -1;
         if (!wanted) return;
-        const std::uint32_t low = std::bit_cast<std::uint32_t>(kGridLow) >> kGridShift;
-        const std::uint32_t high = std::bit_cast<std::uint32_t>(kGridHigh) >> kGridShift;
-        renewal_.reserve(high - low + 1);
-        for (std::uint32_t i = low; i <= high; ++i) {
+        renewal_.reserve(kGridLast - kGridFirst + 1);
+        for (std::uint32_t i = kGridFirst; i <= kGridLast; ++i) {
             RenewalEntry e{};
             e.kappa = static_cast<double>(std::bit_cast<float>(i << kGridShift));
             e.decay = static_cast<T>(std::exp(-e.kappa * h_));
