@@ -72,6 +72,83 @@ INSTANTIATE_TEST_SUITE_P(AllModels, JunctionEquation,
                                            Case{FrictionModel::Enhanced, false, ContactLaw::Amontons},
                                            Case{FrictionModel::Enhanced, true, ContactLaw::PowerLaw}));
 
+// The thermal junction skips work where it can: sticking samples that stay below the limit of
+// a lookup at a warmer temperature do not read the table, and a contact that was still takes
+// the short temperature step. Against the model written out in full (implicit step, table
+// read and stick test every sample), through slips, sticks, force changes, a lifted bow and
+// ambient changes, every result must be the same number.
+TEST(ThermalJunction, DecidesAsTheModelWrittenOutEverySample)
+{
+    for (ContactLaw contact : {ContactLaw::Amontons, ContactLaw::PowerLaw}) {
+        const double fs = 48000.0;
+        BowedStringConfig c;
+        c.friction.model = FrictionModel::Thermal;
+        c.friction.contactLaw = contact;
+        BowedString<double> s;
+        s.prepare(fs, c);
+        ThermalContact<double> reference;
+        reference.prepare(fs, c.friction.thermal);
+        const double twoZ = 2.0 * s.effectiveImpedance();
+        double heatPerLoad = 0.0, slide = 0.0, slopePerLoad = 0.0;
+        int sticks = 0, slips = 0, wellInside = 0;
+        for (int n = 0; n < static_cast<int>(1.5 * fs); ++n) {
+            const double t = n / fs;
+            if (n == static_cast<int>(0.6 * fs)) s.junction().setAmbient(30.0); // the law shifts mid-note
+            double force = t < 0.4 ? 0.6 : (t < 1.0 ? 0.6 + 0.5 * std::sin(9.0 * t) * std::sin(9.0 * t) : 1.2);
+            if (t > 1.3 && t < 1.32) force = 0.0; // lifted for a moment
+            const double speed = 0.25 * std::min(1.0, t / 0.05);
+            BowFrame<double> fr;
+            s.processSample(force, speed, 0.1, &fr);
+
+            const auto& j = s.junction();
+            const double load = j.contactArea().effectiveLoad(force);
+            const double theta = reference.step(heatPerLoad * load, slide, j.contactArea().areaPerNewton * load, slopePerLoad * load);
+            const MuSlope m = j.temperatureLaw().at(theta);
+            const double limit = load * m.mu;
+            const double fStick = twoZ * (speed - fr.history);
+            double f = fStick, v = speed;
+            const bool stick = std::abs(fStick) <= limit;
+            if (stick) {
+                heatPerLoad = slide = slopePerLoad = 0.0;
+                ++sticks;
+            } else {
+                f = fStick >= 0.0 ? limit : -limit;
+                v = fr.history + f * (0.5 / s.effectiveImpedance());
+                const double dv = std::abs(v - speed);
+                heatPerLoad = std::abs(f) * dv * (load > 0.0 ? 1.0 / load : 0.0);
+                slide = dv;
+                slopePerLoad = dv > 0.0 ? dv * m.slope : 0.0;
+                ++slips;
+            }
+            if (stick && limit > 1.01 * std::abs(fStick)) ++wellInside; // where the table read can be skipped
+            ASSERT_EQ(fr.stick, stick) << "sample " << n;
+            ASSERT_EQ(fr.temperature, theta) << "sample " << n;
+            ASSERT_EQ(fr.friction, f) << "sample " << n;
+            ASSERT_EQ(fr.velocity, v) << "sample " << n;
+        }
+        EXPECT_GT(slips, 3000);
+        EXPECT_GT(sticks, 30000);
+        EXPECT_GT(wellInside, 10000);
+    }
+}
+
+// The shortcut rests on friction falling as the contact warms: true of both steady-sliding fits.
+TEST(TemperatureLaw, FrictionFallsAsTheContactWarmsForBothFits)
+{
+    ThermalParams tp;
+    for (SteadyFit fit : {SteadyFit::SmithWoodhouse, SteadyFit::WoodhouseGalluzzo}) {
+        TemperatureLaw law;
+        law.build(fit, std::nullopt, tp);
+        EXPECT_TRUE(law.nonIncreasing());
+        double previous = law(0.0);
+        for (double theta = 0.0; theta < law.thetaMax() + 5.0; theta += 0.01) {
+            ASSERT_LE(law(theta), previous) << "theta=" << theta;
+            previous = law(theta);
+        }
+        EXPECT_LT(law(law.thetaMax()), law(0.0) - 0.2);
+    }
+}
+
 TEST(BowedString, BlockSizeDoesNotChangeTheOutput)
 {
     BowedStringConfig c;

@@ -133,6 +133,7 @@ public:
         heatPerLoadPrev_ = 0.0;
         slidePrev_ = 0.0;
         heatSlopePerLoadPrev_ = 0.0;
+        forgetKnownLimit();
     }
 
     /// [audio thread] Solve this sample. vh: history velocity; vb: bow speed; fb: bow force;
@@ -205,6 +206,15 @@ private:
             law->setShift(params_.thermal.temperatureShift());
             law->setScale(params_.thermal.footprintRatio);
         }
+        forgetKnownLimit();
+    }
+
+    /// The thermal path's remembered lookup (see solveThermal) belongs to the law as it was.
+    void forgetKnownLimit() noexcept
+    {
+        knownTheta_ = -1.0;
+        knownMuFloor_ = -1.0;
+        thermalLawFalls_ = thermalLaw_.nonIncreasing();
     }
 
     /// Uniform in [-1, 1) from xorshift64*: cheap, seeded, the same on every platform.
@@ -347,18 +357,19 @@ private:
         const double load = loadCached_;
         const double D = vb - vh;
         const double fStick = twoZ_ * D;
-        const double theta = stepTemperature();
+        // After a sticking sample there is no heat, sliding or heat slope to pass on (stick()
+        // left them zero): the temperature takes the still step, which skips their bookkeeping.
+        const bool wasStuck = state_ == ContactState::Stick;
+        const double theta = wasStuck ? thermal_.stepStill(area_.areaPerNewton * load) : stepTemperature();
+        // mu falls as the contact warms, so a contact no warmer than at the last lookup holds at
+        // least that lookup's mu. Most sticking samples cool and stay below that limit: they
+        // decide without the table (the same decision; the margin covers rounding in it).
+        if (theta <= knownTheta_ && std::abs(fStick) <= load * knownMuFloor_) return stick(wasStuck, fStick, vb, theta);
         const MuSlope m = thermalLaw_.at(theta);
+        knownTheta_ = theta;
+        knownMuFloor_ = thermalLawFalls_ ? m.mu * (1.0 - 1e-12) : -1.0;
         const double limit = load * m.mu;
-        if (std::abs(fStick) <= limit) {
-            // Sticking makes no heat. Stored as constants, not computed from f and dv (which are
-            // zero anyway), so the next temperature does not wait for this sample's friction.
-            state_ = ContactState::Stick;
-            heatPerLoadPrev_ = 0.0;
-            slidePrev_ = 0.0;
-            heatSlopePerLoadPrev_ = 0.0;
-            return {static_cast<T>(fStick), static_cast<T>(vb), static_cast<T>(theta), true};
-        }
+        if (std::abs(fStick) <= limit) return stick(wasStuck, fStick, vb, theta);
         const bool forward = D >= 0.0;
         double f = forward ? limit : -limit;
         state_ = forward ? ContactState::SlipForward : ContactState::SlipBackward;
@@ -367,6 +378,19 @@ private:
         const double dv = std::abs(v - vb);
         keepHeat(f, dv, dv > 0.0 ? dv * m.slope : 0.0);
         return {static_cast<T>(f), static_cast<T>(v), static_cast<T>(theta), false};
+    }
+
+    [[gnu::always_inline]] JunctionResult<T> stick(bool wasStuck, double fStick, double vb, double theta) noexcept
+    {
+        // Sticking makes no heat. Stored as constants, not computed from f and dv (which are
+        // zero anyway), so the next temperature does not wait for this sample's friction.
+        if (!wasStuck) {
+            state_ = ContactState::Stick;
+            heatPerLoadPrev_ = 0.0;
+            slidePrev_ = 0.0;
+            heatSlopePerLoadPrev_ = 0.0;
+        }
+        return {static_cast<T>(fStick), static_cast<T>(vb), static_cast<T>(theta), true};
     }
 
     /// Friction-curve and enhanced models: mu falls with sliding speed (the jump rule).
@@ -400,6 +424,8 @@ private:
     double zEffCached_ = -1.0, twoZ_ = 1.0, invTwoZ_ = 0.0;
     double noiseLevel_ = 0.0;
     std::uint64_t noiseState_ = 1;
+    double knownTheta_ = -1.0, knownMuFloor_ = -1.0; // the thermal path's last lookup
+    bool thermalLawFalls_ = false;
 };
 
 } // namespace rosin::dsp

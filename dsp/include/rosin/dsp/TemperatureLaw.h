@@ -66,7 +66,11 @@ public:
         lastIndex_ = static_cast<double>(m - 1);
         tableLast_ = table_.back();
         segments_.assign(m - 1, Segment{});
-        for (int i = 0; i + 1 < m; ++i) segments_[i] = {table_[i], table_[i + 1] - table_[i]};
+        nonIncreasing_ = true;
+        for (int i = 0; i + 1 < m; ++i) {
+            segments_[i] = {table_[i], table_[i + 1] - table_[i]};
+            nonIncreasing_ = nonIncreasing_ && segments_[i].rise <= 0.0;
+        }
         built_ = true;
     }
 
@@ -104,6 +108,9 @@ public:
     void setScale(double ratio) noexcept { scale_ = ratio; }
     /// True once build() has run (a default law is flat at 1).
     bool built() const noexcept { return built_; }
+    /// True when the law never rises with temperature (friction falls as the contact warms),
+    /// so its value at a temperature bounds it from below at every cooler one.
+    bool nonIncreasing() const noexcept { return nonIncreasing_ && scale_ >= 0.0; }
 
     /// Largest temperature rise the steady-sliding data reaches (K); the law is flat above.
     double thetaMax() const noexcept { return thetaMax_; }
@@ -120,7 +127,7 @@ private:
     };
     std::vector<double> table_{1.0, 1.0};
     std::vector<Segment> segments_{{1.0, 0.0}};
-    bool built_ = false;
+    bool built_ = false, nonIncreasing_ = true; // the default law is flat
     double step_ = 1.0, invStep_ = 1.0, thetaMax_ = 1.0, shift_ = 0.0, scale_ = 1.0;
     double lastIndex_ = 1.0, tableLast_ = 1.0; // the clamp at() tests every sample, kept at hand
 };

@@ -70,12 +70,12 @@ public:
     {
         for (Pack& z : z_) z = Pack{};
         thetaPrev_ = 0.0;
-        nextHistory_ = 0.0; // no history yet: exact, not a prediction
-        nextHistoryValid_ = true;
+        pendingPoles_ = 0.0; // no history yet
         // The 2 % rule of setKappa remembers the last kappa: forget it, so a reset bank
         // behaves exactly like a freshly prepared one.
         kappa_ = -1.0;
         setKappa(0.0);
+        pendingGain_ = historyGain_; // as if advance() had run: with no states the history is 0 anyway
     }
 
     /// [audio thread] Surface-renewal rate (1/s). True when the coefficients changed.
@@ -99,14 +99,12 @@ public:
             fillCoefficients<false>(e.kappa, e.decay);
             gammaTotal_ = e.gamma;
             historyGain_ = e.historyGain;
-            nextHistoryValid_ = false; // predicted with the old weights
             return true;
         }
         if (kappa > 0.0 && kappa_ > 0.0 && std::abs(kappa - kappa_) < 0.02 * kappa_) return false;
         gridIndex_ = -1;
         kappa_ = kappa;
         fillCoefficients<true>(kappa, static_cast<T>(std::exp(-kappa * h_)));
-        nextHistoryValid_ = false;
         return true;
     }
 
@@ -119,12 +117,19 @@ public:
     /// This step's flux (per unit area and effusivity) is gamma() * theta_new - history().
     double gamma() const noexcept { return gammaTotal_; }
 
-    /// History part of this step's flux (depends on past states only).
-    double history() const noexcept { return nextHistoryValid_ ? nextHistory_ : recomputedHistory(); }
+    /// History part of this step's flux (depends on past states only), from the prediction
+    /// advance() left: historyDrive() + historyThetaGain() * (the temperature it was given).
+    double history() const noexcept { return historyDrive() + historyThetaGain() * thetaPrev_; }
+
+    /// The history split for the implicit update, which folds the second part into its own
+    /// temperature term: historyDrive() does not depend on the last temperature, so it is ready
+    /// before that is solved.
+    double historyDrive() const noexcept { return static_cast<double>(renewalDecay_) * pendingPoles_; }
+    double historyThetaGain() const noexcept { return static_cast<double>(renewalDecay_) * pendingGain_ + tailRate_; }
 
     /// The same, summed from the pole states now (what the prediction in advance() must equal).
     /// The weights w xi eps carry kappa only through the common factor exp(-kappa h), applied
-    /// after the sum: the pole sum need not wait for a new kappa.
+    /// after the sum.
     double recomputedHistory() const noexcept
     {
         Pack acc = weightXiDecayT_[0] * z_[0];
@@ -134,11 +139,13 @@ public:
 
     /// Commit the step with the new temperature.
     ///
-    /// Also predicts the next step's history, sum(w xi eps z') + tail theta with
-    /// z' = eps z + b theta, as sum(w xi eps^2 z) + (sum(w xi eps b) + tail) theta: the pole sum
-    /// then needs only the old states, so it runs while theta is still being solved, and theta
-    /// reaches the next step through one multiply-add instead of the whole bank (the
-    /// sample-to-sample chain is what limits a voice's speed). setKappa() voids the prediction.
+    /// Also predicts the next step's history. With weights w xi eps0 exp(-kappa' h) for the
+    /// kappa' of that step and z' = eps z + b theta, it is
+    ///   exp(-kappa' h) [sum(w xi eps0 eps z) + sum(w xi eps0 b) theta] + tail theta.
+    /// The pole sum needs only the old states, so it runs while theta is still being solved;
+    /// the new kappa enters as one factor, so a change of kappa keeps the prediction; and theta
+    /// reaches the next step as one coefficient of the implicit update, not through the bank
+    /// (the sample-to-sample chain is what limits a voice's speed).
     void advance(double theta) noexcept
     {
         // A fixed pack count unrolls the loops; 44.1-96 kHz need one pack fewer than the slots.
@@ -213,11 +220,10 @@ private:
             const Pack b = (T(1) - eps) / (xiT_[p] + kap);
             decay_[p] = eps;
             gain_[p] = b;
-            const Pack historyWeight = weightXiDecayT_[p] * ek;
-            historyDecay_[p] = historyWeight * eps;
+            historyDecay_[p] = weightXiDecayT_[p] * eps; // exp(-kappa h) is applied to the sum
             if constexpr (WithSums) {
                 g += weightT_[p] * (T(1) - xiT_[p] * b);
-                c += historyWeight * b;
+                c += weightXiDecayT_[p] * b;
             }
         }
         renewalDecay_ = ek;
@@ -228,7 +234,7 @@ private:
                 gain += static_cast<double>(c[j]);
             }
             gammaTotal_ = gamma + tailCapacity_ * (1.0 / h_ + kappa);
-            historyGain_ = gain + tailRate_;
+            historyGain_ = gain;
         }
     }
 
@@ -248,9 +254,9 @@ private:
             if (p < packs) q += historyDecay_[p] * z_[p];
         for (int p = 0; p < P; ++p)
             if (p < packs) z_[p] = decay_[p] * z_[p] + gain_[p] * th;
-        nextHistory_ = static_cast<double>(sum(q)) + historyGain_ * static_cast<double>(th);
-        nextHistoryValid_ = true;
-        thetaPrev_ = static_cast<double>(th);
+        pendingPoles_ = static_cast<double>(sum(q));
+        pendingGain_ = historyGain_;
+        thetaPrev_ = theta;
     }
 
     /// Sum of the lanes by halving (two shuffles for floats, one for doubles).
@@ -266,8 +272,8 @@ private:
     }
 
     double h_ = 1.0 / 48000.0, kappa_ = -1.0, gammaTotal_ = 0.0, tailCapacity_ = 0.0, tailRate_ = 0.0, thetaPrev_ = 0.0;
-    double historyGain_ = 0.0, nextHistory_ = 0.0;
-    bool nextHistoryValid_ = true;
+    double historyGain_ = 0.0;  // sum(w xi eps0 b) of the coefficients in use
+    double pendingPoles_ = 0.0, pendingGain_ = 0.0; // the prediction of the last advance()
     int count_ = 0, packs_ = kPacks, gridIndex_ = -1;
     double gridLow_ = 0.0, gridHigh_ = 0.0;
     std::vector<RenewalEntry> renewal_;
@@ -300,8 +306,7 @@ public:
         stringSide_.reset();
         rodSide_.reset();
         theta_ = 0.0;
-        denCached_ = 0.0;
-        denStill_ = false;
+        stillCached_ = false;
     }
 
     /// [audio thread] One implicit step (PHYSICS.md 3.4). heat = |f dv| and slidingSpeed = |dv|
@@ -318,13 +323,13 @@ public:
             stringSide_.advance(0.0);
             rodSide_.setKappa(0.0);
             rodSide_.advance(0.0);
-            denStill_ = false;
+            stillCached_ = false;
             return theta_;
         }
-        bool denStale = !denStill_;
+        bool stale = !stillCached_;
         if (area != areaCached_) { // everything here follows the bow force only
             areaCached_ = area;
-            denStale = true;
+            stale = true;
             const double radius = std::sqrt(area / std::numbers::pi);
             const double rhoCDelta = params_.rosinHeatCapacity * params_.layerThickness;
             renewalPerSpeed_ = 3.0 / (8.0 * radius);
@@ -333,36 +338,62 @@ public:
             stringEffusion_ = area * params_.stringEffusivity;
             rodEffusion_ = area * params_.rodEffusivity;
         }
-        if (rodSide_.setKappa(renewalPerSpeed_ * slidingSpeed)) denStale = true; // kappa = 3 |dv| / (8 a)
+        if (rodSide_.setKappa(renewalPerSpeed_ * slidingSpeed)) stale = true; // kappa = 3 |dv| / (8 a)
         const double slope = std::min(heatSlope, 0.0);
-        const double num = (storage_ - slope) * theta_ + heat + stringEffusion_ * stringSide_.history()
-                           + rodEffusion_ * rodSide_.history();
-        // While sticking nothing in the denominator moves (no sliding, no heat slope, the same
-        // area and rod weights), so neither it nor its reciprocal is recomputed: the division
-        // sits on the sample-to-sample dependency chain and is its slowest link.
+        // theta = num / den with num = (storage - slope) theta_prev + heat + the two sides'
+        // histories. The histories' own theta_prev terms are gathered into one coefficient, so
+        // the previous temperature passes through one multiply-add here, and everything else
+        // in num (the drive) is ready before it.
+        const double drive = heat + stringEffusion_ * stringSide_.historyDrive() + rodEffusion_ * rodSide_.historyDrive();
+        const double rodGain = rodSide_.historyThetaGain(); // follows the rod's kappa one step late
+        // While sticking nothing in the coefficients moves (no sliding, no heat slope, the same
+        // area and rod weights), so they and the reciprocal of den are kept: the division would
+        // otherwise sit on the sample-to-sample chain.
         const bool still = slidingSpeed == 0.0 && slope == 0.0;
-        if (denStale || !still) {
+        if (stale || !still || rodGain != rodGainCached_) {
             const double den = storage_ + advectionPerSpeed_ * slidingSpeed - slope + stringEffusion_ * stringSide_.gamma()
                                + rodEffusion_ * rodSide_.gamma();
-            if (den != denCached_) {
-                denCached_ = den;
-                invDenCached_ = 1.0 / den;
+            const double self = storage_ - slope + stringEffusion_ * stringSide_.historyThetaGain() + rodEffusion_ * rodGain;
+            stillCached_ = still;
+            if (!still) { // slipping: the coefficients change every sample, divide once
+                theta_ = std::max(0.0, (self * theta_ + drive) / den);
+                return commit();
             }
+            invDenCached_ = 1.0 / den;
+            thetaGainCached_ = self * invDenCached_;
+            rodGainCached_ = rodGain;
         }
-        denStill_ = still;
-        theta_ = std::max(0.0, num * invDenCached_);
-        stringSide_.advance(theta_);
-        rodSide_.advance(theta_);
-        return theta_;
+        theta_ = std::max(0.0, thetaGainCached_ * theta_ + drive * invDenCached_);
+        return commit();
+    }
+
+    /// step(0, 0, area, 0), the same numbers, for a contact that was also still in the last
+    /// step (no heat, no sliding): once the coefficients are kept, only the drive is new.
+    double stepStill(double area) noexcept
+    {
+        if (!stillCached_ || area != areaCached_ || rodSide_.historyThetaGain() != rodGainCached_)
+            return step(0.0, 0.0, area, 0.0);
+        const double drive = stringEffusion_ * stringSide_.historyDrive() + rodEffusion_ * rodSide_.historyDrive();
+        theta_ = std::max(0.0, thetaGainCached_ * theta_ + drive * invDenCached_);
+        return commit();
     }
 
     double temperature() const noexcept { return theta_; }
     const ThermalParams& params() const noexcept { return params_; }
 
 private:
+    double commit() noexcept
+    {
+        stringSide_.advance(theta_);
+        rodSide_.advance(theta_);
+        return theta_;
+    }
+
     ThermalParams params_;
-    double h_ = 1.0 / 48000.0, rate_ = 48000.0, theta_ = 0.0, areaCached_ = -1.0, denCached_ = 0.0, invDenCached_ = 0.0;
-    bool denStill_ = false; // denCached_ was computed for a still contact (see step)
+    double h_ = 1.0 / 48000.0, rate_ = 48000.0, theta_ = 0.0, areaCached_ = -1.0;
+    // The update's coefficients kept from the last still sample (see step).
+    double invDenCached_ = 0.0, thetaGainCached_ = 0.0, rodGainCached_ = 0.0;
+    bool stillCached_ = false;
     double renewalPerSpeed_ = 0.0, storage_ = 0.0, advectionPerSpeed_ = 0.0, stringEffusion_ = 0.0, rodEffusion_ = 0.0;
     ConductionBank<T> stringSide_, rodSide_;
 };
