@@ -357,10 +357,8 @@ private:
         const double load = loadCached_;
         const double D = vb - vh;
         const double fStick = twoZ_ * D;
-        // After a sticking sample there is no heat, sliding or heat slope to pass on (stick()
-        // left them zero): the temperature takes the still step, which skips their bookkeeping.
         const bool wasStuck = state_ == ContactState::Stick;
-        const double theta = wasStuck ? thermal_.stepStill(area_.areaPerNewton * load) : stepTemperature();
+        const double theta = stepTemperature();
         // mu falls as the contact warms, so a contact no warmer than at the last lookup holds at
         // least that lookup's mu. Most sticking samples cool and stay below that limit: they
         // decide without the table (the same decision; the margin covers rounding in it).
@@ -383,7 +381,8 @@ private:
     [[gnu::always_inline]] JunctionResult<T> stick(bool wasStuck, double fStick, double vb, double theta) noexcept
     {
         // Sticking makes no heat. Stored as constants, not computed from f and dv (which are
-        // zero anyway), so the next temperature does not wait for this sample's friction.
+        // zero anyway), so the next temperature does not wait for this sample's friction; a
+        // sample that was already sticking left them so.
         if (!wasStuck) {
             state_ = ContactState::Stick;
             heatPerLoadPrev_ = 0.0;

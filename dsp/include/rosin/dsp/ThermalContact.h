@@ -326,10 +326,15 @@ public:
             stillCached_ = false;
             return theta_;
         }
-        bool stale = !stillCached_;
+        const double slope = std::min(heatSlope, 0.0);
+        // While sticking nothing in the update's coefficients moves (no sliding, no heat slope,
+        // the same area and rod weights), so they and the reciprocal of den are kept from the
+        // last still step: the division would otherwise sit on the sample-to-sample chain.
+        const bool still = slidingSpeed == 0.0 && slope == 0.0;
+        if (still && stillCached_ && area == areaCached_ && rodSide_.historyThetaGain() == rodGainCached_)
+            return keptStep(heat + conductionDrive()); // (kappa is already 0: the last step was still)
         if (area != areaCached_) { // everything here follows the bow force only
             areaCached_ = area;
-            stale = true;
             const double radius = std::sqrt(area / std::numbers::pi);
             const double rhoCDelta = params_.rosinHeatCapacity * params_.layerThickness;
             renewalPerSpeed_ = 3.0 / (8.0 * radius);
@@ -338,50 +343,44 @@ public:
             stringEffusion_ = area * params_.stringEffusivity;
             rodEffusion_ = area * params_.rodEffusivity;
         }
-        if (rodSide_.setKappa(renewalPerSpeed_ * slidingSpeed)) stale = true; // kappa = 3 |dv| / (8 a)
-        const double slope = std::min(heatSlope, 0.0);
+        rodSide_.setKappa(renewalPerSpeed_ * slidingSpeed); // kappa = 3 |dv| / (8 a)
         // theta = num / den with num = (storage - slope) theta_prev + heat + the two sides'
         // histories. The histories' own theta_prev terms are gathered into one coefficient, so
-        // the previous temperature passes through one multiply-add here, and everything else
-        // in num (the drive) is ready before it.
-        const double drive = heat + stringEffusion_ * stringSide_.historyDrive() + rodEffusion_ * rodSide_.historyDrive();
+        // the previous temperature passes through one multiply-add, and everything else in num
+        // (the drive) is ready before it.
+        const double drive = heat + conductionDrive();
         const double rodGain = rodSide_.historyThetaGain(); // follows the rod's kappa one step late
-        // While sticking nothing in the coefficients moves (no sliding, no heat slope, the same
-        // area and rod weights), so they and the reciprocal of den are kept: the division would
-        // otherwise sit on the sample-to-sample chain.
-        const bool still = slidingSpeed == 0.0 && slope == 0.0;
-        if (stale || !still || rodGain != rodGainCached_) {
-            const double den = storage_ + advectionPerSpeed_ * slidingSpeed - slope + stringEffusion_ * stringSide_.gamma()
-                               + rodEffusion_ * rodSide_.gamma();
-            const double self = storage_ - slope + stringEffusion_ * stringSide_.historyThetaGain() + rodEffusion_ * rodGain;
-            stillCached_ = still;
-            if (!still) { // slipping: the coefficients change every sample, divide once
-                theta_ = std::max(0.0, (self * theta_ + drive) / den);
-                return commit();
-            }
-            invDenCached_ = 1.0 / den;
-            thetaGainCached_ = self * invDenCached_;
-            rodGainCached_ = rodGain;
+        const double den = storage_ + advectionPerSpeed_ * slidingSpeed - slope + stringEffusion_ * stringSide_.gamma()
+                           + rodEffusion_ * rodSide_.gamma();
+        const double self = storage_ - slope + stringEffusion_ * stringSide_.historyThetaGain() + rodEffusion_ * rodGain;
+        stillCached_ = still;
+        if (!still) { // slipping: the coefficients change every sample, divide once
+            theta_ = std::max(0.0, (self * theta_ + drive) / den);
+            return commit();
         }
-        theta_ = std::max(0.0, thetaGainCached_ * theta_ + drive * invDenCached_);
-        return commit();
-    }
-
-    /// step(0, 0, area, 0), the same numbers, for a contact that was also still in the last
-    /// step (no heat, no sliding): once the coefficients are kept, only the drive is new.
-    double stepStill(double area) noexcept
-    {
-        if (!stillCached_ || area != areaCached_ || rodSide_.historyThetaGain() != rodGainCached_)
-            return step(0.0, 0.0, area, 0.0);
-        const double drive = stringEffusion_ * stringSide_.historyDrive() + rodEffusion_ * rodSide_.historyDrive();
-        theta_ = std::max(0.0, thetaGainCached_ * theta_ + drive * invDenCached_);
-        return commit();
+        invDenCached_ = 1.0 / den;
+        thetaGainCached_ = self * invDenCached_;
+        rodGainCached_ = rodGain;
+        return keptStep(drive);
     }
 
     double temperature() const noexcept { return theta_; }
     const ThermalParams& params() const noexcept { return params_; }
 
 private:
+    /// The two sides' histories without their theta_prev terms, weighted by area and effusivity.
+    double conductionDrive() const noexcept
+    {
+        return stringEffusion_ * stringSide_.historyDrive() + rodEffusion_ * rodSide_.historyDrive();
+    }
+
+    /// The implicit update with the coefficients kept from a still step.
+    double keptStep(double drive) noexcept
+    {
+        theta_ = std::max(0.0, thetaGainCached_ * theta_ + drive * invDenCached_);
+        return commit();
+    }
+
     double commit() noexcept
     {
         stringSide_.advance(theta_);
