@@ -11,6 +11,7 @@ CORE_PKGS=(
   libcairo2-dev fonts-dejavu-core          # figures (PNG) drawn by lab/
   libopenmpi-dev openmpi-bin               # Guettler sweeps over several processes/machines
   libnlopt-cxx-dev                         # fitting model extensions in diagnosis
+  libeigen3-dev                            # linear algebra in the lab: covariances of fitted parameters
   # The instrument: JUCE 7.0.5 from Debian (its -dev dependencies come with it), LV2 headers,
   # JACK for the Standalone, and the checks a DAW user's machine would run.
   juce-modules-source lv2-dev libjack-jackd2-dev

@@ -2,7 +2,10 @@
 
 #include <sndfile.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -33,6 +36,49 @@ double positive(const json& obj, const char* key, const fs::path& file, const st
     if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() <= 0.0)
         fail(file, where + key, "must be a positive number");
     return v.get<double>();
+}
+
+/// steady_sliding.csv: header `speed_m_s,mu` and optionally `,force_n`; every value finite,
+/// speeds >= 0, mu > 0 (MEASUREMENT_FORMAT.md).
+std::vector<SteadySlidingPoint> readSteadySliding(const fs::path& file)
+{
+    std::ifstream in(file);
+    if (!in) throw LabError(file.string() + ": cannot be read");
+    std::string line;
+    if (!std::getline(in, line)) throw LabError(file.string() + ":1: empty file (expected the header speed_m_s,mu)");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::vector<std::string> cols;
+    for (std::stringstream ss(line); std::getline(ss, line, ',');) cols.push_back(line);
+    int iv = -1, im = -1, iforce = -1;
+    for (int k = 0; k < static_cast<int>(cols.size()); ++k) {
+        if (cols[static_cast<std::size_t>(k)] == "speed_m_s") iv = k;
+        else if (cols[static_cast<std::size_t>(k)] == "mu") im = k;
+        else if (cols[static_cast<std::size_t>(k)] == "force_n") iforce = k;
+    }
+    if (iv < 0 || im < 0) throw LabError(file.string() + ":1: header must name the columns speed_m_s and mu");
+    std::vector<SteadySlidingPoint> out;
+    int lineNo = 1;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) continue;
+        std::vector<double> v;
+        for (std::stringstream ss(line); std::getline(ss, line, ',');) {
+            char* end = nullptr;
+            const double x = std::strtod(line.c_str(), &end);
+            if (end == line.c_str() || !std::isfinite(x))
+                throw LabError(file.string() + ":" + std::to_string(lineNo) + ": field '" + cols[std::min(v.size(), cols.size() - 1)] + "' is not a number");
+            v.push_back(x);
+        }
+        if (v.size() != cols.size()) throw LabError(file.string() + ":" + std::to_string(lineNo) + ": expected " + std::to_string(cols.size()) + " values");
+        SteadySlidingPoint p{v[static_cast<std::size_t>(iv)], v[static_cast<std::size_t>(im)], iforce >= 0 ? v[static_cast<std::size_t>(iforce)] : 0.0};
+        if (p.speed < 0.0) throw LabError(file.string() + ":" + std::to_string(lineNo) + ": field 'speed_m_s' must not be negative");
+        if (!(p.mu > 0.0)) throw LabError(file.string() + ":" + std::to_string(lineNo) + ": field 'mu' must be positive");
+        if (iforce >= 0 && !(p.force > 0.0)) throw LabError(file.string() + ":" + std::to_string(lineNo) + ": field 'force_n' must be positive");
+        out.push_back(p);
+    }
+    if (out.size() < 2) throw LabError(file.string() + ": needs at least two rows of steady-sliding data");
+    return out;
 }
 
 std::vector<double> readWavChannel(const fs::path& file, int channel, double manifestRate, std::vector<std::string>& warnings)
@@ -216,6 +262,7 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
         if (!ss.is_object() || !ss.contains("file") || !ss["file"].is_string()) fail(manifest, "steady_sliding.file", "is missing");
         set.steadySliding = folder / ss["file"].get<std::string>();
         if (!fs::exists(*set.steadySliding)) fail(manifest, "steady_sliding.file", "names a file that does not exist");
+        set.steady = readSteadySliding(*set.steadySliding);
     }
     return set;
 }
@@ -291,6 +338,18 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
                        {"gesture", {{"kind", set.gesture}}}, {"transients", strokes}};
         json full = doc;
         if (!twoEnded.empty()) full["two_ended"] = twoEnded;
+        if (!set.steady.empty()) {
+            std::ofstream csv(tmp / "steady_sliding.csv");
+            const bool withForce = std::all_of(set.steady.begin(), set.steady.end(), [](const auto& p) { return p.force > 0.0; });
+            csv << (withForce ? "speed_m_s,mu,force_n\n" : "speed_m_s,mu\n");
+            char row[96];
+            for (const auto& p : set.steady) {
+                if (withForce) std::snprintf(row, sizeof row, "%.9g,%.9g,%.9g\n", p.speed, p.mu, p.force);
+                else std::snprintf(row, sizeof row, "%.9g,%.9g\n", p.speed, p.mu);
+                csv << row;
+            }
+            full["steady_sliding"] = {{"file", "steady_sliding.csv"}};
+        }
         std::ofstream(tmp / "manifest.json") << full.dump(1) << "\n";
         fs::rename(tmp, folder);
     } catch (...) {

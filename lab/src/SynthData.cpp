@@ -9,6 +9,7 @@
 #include <random>
 
 #include "rosin/lab/Error.h"
+#include "rosin/lab/ReferenceData.h"
 #include "rosin/lab/Resample.h"
 
 namespace rosin::lab {
@@ -53,6 +54,9 @@ dsp::BowedStringConfig modelWithEffects(const std::vector<std::string>& effects,
 
 MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress)
 {
+    if (spec.generator == "reference") return synthesizeReference(spec, truth, progress);
+    if (spec.generator != "model") throw LabError("--generator must be model or reference");
+    if (!spec.rig.empty()) throw LabError("--rig-param applies to --generator reference only");
     if (spec.grid < 2 || spec.grid > 60) throw LabError("--grid must be within 2..60");
     if (!(spec.outRate >= 8000 && spec.outRate <= 384000)) throw LabError("--rate must be within 8000..384000 Hz");
     if (!(spec.simRate >= spec.outRate)) throw LabError("--sim-rate must not be below --rate");

@@ -19,6 +19,7 @@
 #include "rosin/lab/Guettler.h"
 #include "rosin/lab/Measurement.h"
 #include "rosin/lab/Output.h"
+#include "rosin/lab/ReferenceData.h"
 #include "rosin/lab/Render.h"
 #include "rosin/lab/Signal.h"
 #include "rosin/lab/SynthData.h"
@@ -31,17 +32,25 @@ namespace {
 struct SynthDataCommand {
     SynthSpec synth;
     std::string synthOut = "set", wavKind = "pcm24";
-    std::vector<std::string> synthParams;
+    std::vector<std::string> synthParams, rigParams;
     bool synthQuiet = false;
 
     CLI::App* add(CLI::App& app)
     {
         CLI::App* synthCmd = app.add_subcommand("synth-data", "Write a measurement set (rosin-measurement/1) simulated with hidden "
                                                               "effects and a real rig's artefacts");
-        synthCmd->footer("Effects (shared/docs/DIAGNOSIS.md): thermal_memory, rate_dependence, hertzian_contact,\n"
+        std::string rigKeys;
+        for (const auto& p : referenceRigPriors()) rigKeys += "  " + p.key + ": " + p.meaning + "\n";
+        synthCmd->footer("Effects (docs/diagnosis.md): thermal_memory, rate_dependence, hertzian_contact,\n"
                          "rosin_temperature_shift, torsional_compliance; none given = the baseline (friction curve,\n"
                          "Amontons, no torsion, reference rosin). Their parameters are drawn from the seed unless\n"
-                         "given, and written with the gain to OUT.truth.json beside the set, never inside it.");
+                         "given, and written with the gain to OUT.truth.json beside the set, never inside it.\n"
+                         "--generator model: dsp/'s own model makes the data (a consistency check).\n"
+                         "--generator reference: the reference simulator (finite-difference stiff string, bridge\n"
+                         "resonances, exact-kernel heat) on a rig drawn from the seed; --rig-param fixes a value:\n" + rigKeys);
+        synthCmd->add_option("--generator", synth.generator, "model or reference")->check(CLI::IsMember({"model", "reference"}))->capture_default_str();
+        synthCmd->add_option("--rig-param", rigParams, "Reference rig value NAME=VALUE instead of a drawn one (see below)");
+        synthCmd->add_option("--oversampling", synth.oversampling, "Reference: simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         synthCmd->add_option("-o,--out", synthOut, "New folder for the set (must not exist)")->capture_default_str();
         synthCmd->add_option("--effect", synth.effects, "Hidden effect; repeat for several")->check(CLI::IsMember(effectIds()));
         synthCmd->add_option("--param", synthParams, "Hidden parameter NAME=VALUE (r_A, h0, p, load_exponent, shift_k, zt_ratio)");
@@ -79,6 +88,15 @@ struct SynthDataCommand {
                 throw LabError("--param: '" + kv + "' has no number");
             }
         }
+        for (const auto& kv : rigParams) {
+            const auto eq = kv.find('=');
+            if (eq == std::string::npos) throw LabError("--rig-param: expected NAME=VALUE, got '" + kv + "'");
+            try {
+                synth.rig[kv.substr(0, eq)] = std::stod(kv.substr(eq + 1));
+            } catch (const std::exception&) {
+                throw LabError("--rig-param: '" + kv + "' has no number");
+            }
+        }
         if (fs::exists(synthOut)) throw LabError(synthOut + ": already exists (choose a new folder)");
         const std::map<std::string, int> formats{{"pcm16", SF_FORMAT_PCM_16}, {"pcm24", SF_FORMAT_PCM_24},
                                                  {"pcm32", SF_FORMAT_PCM_32}, {"float", SF_FORMAT_FLOAT},
@@ -90,9 +108,16 @@ struct SynthDataCommand {
         OutputSet outputs;
         const fs::path truthTmp = outputs.add(synthOut + ".truth.json");
         {
-            nlohmann::json t{{"format", "rosin-synth-truth/1"}, {"effects", truth.effects}, {"params", truth.params},
-                             {"gain_units_per_N", truth.gain}, {"seed", synth.seed},
+            nlohmann::json t{{"format", "rosin-synth-truth/1"}, {"generator", truth.generator}, {"effects", truth.effects},
+                             {"params", truth.params}, {"gain_units_per_N", truth.gain}, {"seed", synth.seed},
                              {"triggers_s", truth.triggers}};
+            if (truth.generator == "reference") {
+                t["rig"] = truth.rig;
+                t["clipped_fraction"] = truth.clippedFraction;
+                nlohmann::json strokes;
+                for (const auto& [id, af] : truth.strokes) strokes[id] = {{"accel_m_s2", af.first}, {"force_n", af.second}};
+                t["strokes"] = strokes;
+            }
             std::ofstream(truthTmp) << t.dump(1) << "\n";
         }
         writeMeasurementSet(synthOut, set, formats.at(wavKind));

@@ -28,6 +28,12 @@ struct TwoEndedRecording {
     std::vector<double> bridge, far; ///< sensor units, at the set's rate
 };
 
+/// One row of steady_sliding.csv: friction measured in steady sliding at one speed.
+struct SteadySlidingPoint {
+    double speed = 0, mu = 0;
+    double force = 0; ///< N; 0 when the file has no force column
+};
+
 struct MeasurementSet {
     std::filesystem::path folder;
     std::string description;
@@ -43,6 +49,7 @@ struct MeasurementSet {
     std::string gesture = "guettler";  ///< guettler, exp_speed, exp_force
     std::vector<MeasuredStroke> strokes;
     std::optional<std::filesystem::path> steadySliding;
+    std::vector<SteadySlidingPoint> steady; ///< its rows (read from, or written to, steady_sliding.csv)
     std::vector<TwoEndedRecording> twoEnded;
     std::vector<std::string> warnings; ///< what the reader had to decide (said, not silently done)
 };

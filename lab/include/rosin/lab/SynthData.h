@@ -39,6 +39,12 @@ struct SynthSpec {
     double seconds = 0.35;                ///< length of each stroke after the trigger
     bool gaussianReflections = false;     ///< another reflection-filter design than the project's own
     int twoEnded = 2;                     ///< steady strokes recorded at both ends (0 = none)
+    /// "model": dsp/'s own model makes the data (a consistency check of the diagnosis);
+    /// "reference": the reference simulator (lab/reference, no code shared with dsp/) on a
+    /// rig drawn with every nuisance a lab never knows exactly (ReferenceData.h).
+    std::string generator = "model";
+    std::map<std::string, double> rig;    ///< reference: rig values fixed instead of drawn (referenceRigKeys())
+    int oversampling = 4;                 ///< reference: simulation rate / file rate (>= 4)
 };
 
 struct SynthTruth {
@@ -46,6 +52,10 @@ struct SynthTruth {
     std::map<std::string, double> params;
     double gain = 1.0; ///< signal units per newton
     std::map<std::string, double> triggers; ///< stroke id -> gesture start in its file (s)
+    std::string generator = "model";
+    std::map<std::string, double> rig;      ///< reference: every drawn rig value (referenceRigKeys())
+    std::map<std::string, std::pair<double, double>> strokes; ///< stroke id -> true (accel, force)
+    double clippedFraction = 0.0;           ///< share of samples at full scale
 };
 
 /// Simulates the set (all cores) and returns it with the hidden truth.

@@ -1,0 +1,36 @@
+// `rosin synth-data --generator reference`: measurement sets made by the reference simulator
+// (lab/reference, which shares no code with dsp/) on a rig drawn per set. Besides the hidden
+// effects, the rig draws what a lab never knows exactly: tension and bow position off the
+// manifest, static friction and the steady-sliding curve off the standard fit, thermal
+// constants within their literature ranges, string stiffness and losses, a bridge with two
+// resonances, a force sensor with its own transfer function, mains hum, DC, noise from clean to
+// poor, sometimes clipping. The manifest carries only what a lab would write down; the truth
+// file records everything.
+#pragma once
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "rosin/lab/SynthData.h"
+
+namespace rosin::lab {
+
+/// One drawn rig value: uniform (or log-uniform) between lo and hi unless fixed by the user.
+struct RigPrior {
+    std::string key;
+    double lo, hi;
+    bool logScale;
+    std::string meaning;
+};
+
+/// Every rig value the reference generator draws, in the order it draws them.
+const std::vector<RigPrior>& referenceRigPriors();
+
+/// Priors of the hidden effects' parameters in reference sets. They reach weak effects close
+/// to none: shifts from 1 K, load exponents up to 0.95, Z_t/Z_0 up to 8.
+const std::map<std::string, std::pair<double, double>>& referenceEffectPriors();
+
+MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress = {});
+
+} // namespace rosin::lab

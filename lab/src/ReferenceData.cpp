@@ -1,0 +1,324 @@
+#include "rosin/lab/ReferenceData.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <numbers>
+#include <random>
+
+#include "rosin/lab/Error.h"
+#include "rosin/lab/Resample.h"
+#include "rosin/reference/Simulator.h"
+
+namespace rosin::lab {
+
+namespace {
+bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
+constexpr double kPi = std::numbers::pi;
+
+// What the manifest says: the lab's nominal cello D (PHYSICS.md 1.6), tuned to pitch.
+constexpr double kManifestF0 = 146.83, kManifestLength = 0.69, kManifestTension = 102.6;
+
+/// A piezo force sensor and its charge amplifier: a mechanical resonance above the band and
+/// a slow high-pass (the amplifier's time constant), run at the simulation rate.
+struct Sensor {
+    double b0, b1, b2, a1, a2, hp;
+    Sensor(double resonanceHz, double q, double highpassHz, double fs)
+    {
+        const double w = 2.0 * kPi * resonanceHz / fs, cw = std::cos(w), alpha = std::sin(w) / (2.0 * q), a0 = 1.0 + alpha;
+        b0 = b2 = (1.0 - cw) / 2.0 / a0;
+        b1 = (1.0 - cw) / a0;
+        a1 = -2.0 * cw / a0;
+        a2 = (1.0 - alpha) / a0;
+        hp = 1.0 / (1.0 + 2.0 * kPi * highpassHz / fs);
+    }
+    void apply(std::vector<double>& x) const
+    {
+        double x1 = 0, x2 = 0, y1 = 0, y2 = 0, hx = 0, hy = 0;
+        for (double& v : x) {
+            const double y = b0 * v + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
+            x2 = x1;
+            x1 = v;
+            y2 = y1;
+            y1 = y;
+            hy = hp * (hy + y - hx);
+            hx = y;
+            v = hy;
+        }
+    }
+};
+} // namespace
+
+const std::vector<RigPrior>& referenceRigPriors()
+{
+    static const std::vector<RigPrior> p{
+        {"tension_error", -0.04, 0.04, false, "true tension / manifest tension - 1"},
+        {"beta_error", -0.03, 0.03, false, "true bow position / manifest beta - 1"},
+        {"mu_level", 0.93, 1.07, false, "the rig's steady-sliding friction (and static friction) / the SW00 fit"},
+        {"mu_v1_scale", 0.8, 1.25, true, "speed scale of the fast exponential / 0.01 m/s"},
+        {"mu_v2_scale", 0.8, 1.25, true, "speed scale of the slow exponential / 0.1 m/s"},
+        {"mu_floor_scale", 0.9, 1.1, false, "high-speed friction / 0.35"},
+        {"contact_radius_um", 150.0, 350.0, false, "contact radius at 1 N (um)"},
+        {"layer_um", 0.5, 2.0, true, "rosin layer thickness (um)"},
+        {"rosin_heat", 1.4e6, 1.8e6, false, "rosin rho c (J m^-3 K^-1)"},
+        {"string_effusivity", 1600.0, 2500.0, false, "string side (W s^1/2 m^-2 K^-1)"},
+        {"rod_effusivity", 300.0, 600.0, false, "rod side (W s^1/2 m^-2 K^-1)"},
+        {"inharmonicity", 5e-6, 1e-4, true, "string stiffness B"},
+        {"q_low", 300.0, 800.0, true, "transverse Q at f0"},
+        {"q_high", 80.0, 250.0, true, "transverse Q at 5 kHz"},
+        {"bridge_hz", 800.0, 3000.0, true, "bridge resonance (Hz)"},
+        {"bridge_q", 8.0, 30.0, true, "bridge resonance Q"},
+        {"bridge_z0y", 0.005, 0.05, true, "Z0 x the bridge resonance's peak admittance"},
+        {"body_hz", 150.0, 500.0, true, "body resonance seen at the bridge (Hz)"},
+        {"body_q", 10.0, 40.0, true, "body resonance Q"},
+        {"body_z0y", 0.002, 0.02, true, "Z0 x the body resonance's peak admittance"},
+        {"torsion_speed_ratio", 4.5, 6.0, false, "c_t / c (used when torsion is a hidden effect)"},
+        {"q_torsion", 15.0, 60.0, true, "torsional Q"},
+        {"sensor_hz", 8000.0, 20000.0, true, "force sensor resonance (Hz)"},
+        {"sensor_q", 0.7, 4.0, true, "force sensor resonance Q"},
+        {"highpass_hz", 0.005, 0.2, true, "charge amplifier high-pass corner (Hz)"},
+        {"hum_hz", 0.0, 60.0, false, "mains: 0 (none, 20 %), 50 or 60 Hz"},
+        {"hum_n", 0.002, 0.05, true, "hum amplitude at the mains frequency (N)"},
+        {"dc_n", -0.3, 0.3, false, "DC offset (N)"},
+        {"noise_n", 1e-4, 0.03, true, "white noise, rms (N): clean to poor"},
+        {"headroom", 0.3, 1.4, false, "loudest stroke / full scale (V sets): above 1 clips (20 % of sets)"},
+    };
+    return p;
+}
+
+const std::map<std::string, std::pair<double, double>>& referenceEffectPriors()
+{
+    static const std::map<std::string, std::pair<double, double>> p{
+        {"r_A", {0.7, 1.4}}, {"h0", {0.45, 0.85}}, {"p", {0.1, 0.6}}, {"load_exponent", {0.55, 0.95}},
+        {"shift_k", {1.0, 20.0}}, {"zt_ratio", {1.2, 8.0}}};
+    return p;
+}
+
+MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress)
+{
+    if (spec.grid < 2 || spec.grid > 60) throw LabError("--grid must be within 2..60");
+    if (!(spec.outRate >= 8000 && spec.outRate <= 384000)) throw LabError("--rate must be within 8000..384000 Hz");
+    if (spec.oversampling < 4 || spec.oversampling > 32) throw LabError("--oversampling must be within 4..32 (the reference runs at least 4x the file rate)");
+    if (spec.units != "V" && spec.units != "N") throw LabError("--units must be V or N");
+    for (const auto& [key, value] : spec.rig) {
+        const auto& pr = referenceRigPriors();
+        if (std::none_of(pr.begin(), pr.end(), [&](const RigPrior& r) { return r.key == key; }))
+            throw LabError("--rig-param: unknown rig value '" + key + "' (rosin synth-data --help lists them)");
+        if (!std::isfinite(value)) throw LabError("--rig-param: " + key + " must be a finite number");
+    }
+    std::mt19937_64 rng(spec.seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    truth = SynthTruth{};
+    truth.generator = "reference";
+    for (const auto& id : effectIds()) {
+        const bool implied = id == "thermal_memory" && (has(spec.effects, "rosin_temperature_shift") || has(spec.effects, "rate_dependence"));
+        if (has(spec.effects, id) || implied) truth.effects.push_back(id);
+    }
+    auto draw = [&](const char* key) {
+        const auto [lo, hi] = referenceEffectPriors().at(key);
+        const double x = lo + (hi - lo) * u(rng);
+        const auto it = spec.params.find(key);
+        truth.params[key] = it != spec.params.end() ? it->second : x;
+    };
+    if (has(truth.effects, "thermal_memory")) draw("r_A");
+    if (has(truth.effects, "rate_dependence")) { draw("h0"); draw("p"); }
+    if (has(truth.effects, "hertzian_contact")) draw("load_exponent");
+    if (has(truth.effects, "rosin_temperature_shift")) {
+        draw("shift_k");
+        const bool negative = u(rng) < 0.5;
+        if (!spec.params.count("shift_k") && negative) truth.params["shift_k"] = -truth.params["shift_k"];
+    }
+    if (has(truth.effects, "torsional_compliance")) draw("zt_ratio");
+    // The rig: every value drawn in a fixed order (so a fixed value does not move the others).
+    std::map<std::string, double>& rig = truth.rig;
+    for (const RigPrior& p : referenceRigPriors()) {
+        const double x = u(rng), y = u(rng);
+        double v = p.logScale ? p.lo * std::pow(p.hi / p.lo, x) : p.lo + (p.hi - p.lo) * x;
+        if (p.key == "hum_hz") v = x < 0.2 ? 0.0 : (y < 0.5 ? 50.0 : 60.0);
+        if (p.key == "headroom") v = x < 0.2 ? 1.05 + 0.35 * y : 0.3 + 0.6 * y;
+        const auto it = spec.rig.find(p.key);
+        rig[p.key] = it != spec.rig.end() ? it->second : v;
+    }
+    const auto param = [&](const char* key) { return truth.params.at(key); };
+
+    // The true string: the lab tuned it to the manifest's pitch, but its tension is not the
+    // string maker's figure, and the bow is not exactly where the lab measured it.
+    reference::Rig r;
+    const double tension = kManifestTension * (1.0 + rig["tension_error"]);
+    const double B = rig["inharmonicity"];
+    const double idealF0 = kManifestF0 / std::sqrt(1.0 + B);
+    r.string.length = kManifestLength;
+    r.string.tension = tension;
+    r.string.massPerLength = tension / std::pow(2.0 * kManifestLength * idealF0, 2.0);
+    r.string.inharmonicity = B;
+    r.string.qLow = rig["q_low"];
+    r.string.qHigh = rig["q_high"];
+    const double z0 = r.string.impedance();
+    r.bridge.push_back({rig["body_hz"], rig["body_q"], rig["body_z0y"] / z0});
+    r.bridge.push_back({rig["bridge_hz"], rig["bridge_q"], rig["bridge_z0y"] / z0});
+    reference::Friction& f = r.friction;
+    f.steady.level = rig["mu_level"];
+    f.steady.v1 *= rig["mu_v1_scale"];
+    f.steady.v2 *= rig["mu_v2_scale"];
+    f.steady.a3 *= rig["mu_floor_scale"];
+    f.contact.radiusAtReference = rig["contact_radius_um"] * 1e-6;
+    f.contact.layerThickness = rig["layer_um"] * 1e-6;
+    f.contact.rosinVolumetricHeat = rig["rosin_heat"];
+    f.contact.stringEffusivity = rig["string_effusivity"];
+    f.contact.rodEffusivity = rig["rod_effusivity"];
+    if (has(truth.effects, "thermal_memory")) {
+        f.law = reference::FrictionLaw::Thermal;
+        f.footprintRatio = param("r_A");
+    }
+    if (has(truth.effects, "rate_dependence")) {
+        f.law = reference::FrictionLaw::Enhanced;
+        f.speed = {param("h0"), 0.35, param("p")};
+    }
+    if (has(truth.effects, "hertzian_contact")) f.loadExponent = param("load_exponent");
+    if (has(truth.effects, "rosin_temperature_shift")) f.temperatureShiftK = param("shift_k");
+    if (has(truth.effects, "torsional_compliance")) {
+        r.string.torsion = true;
+        r.string.torsionImpedanceRatio = param("zt_ratio");
+        r.string.torsionSpeedRatio = rig["torsion_speed_ratio"];
+        r.string.qTorsion = rig["q_torsion"];
+    }
+    const double beta = spec.beta * (1.0 + rig["beta_error"]);
+    const double simRate = spec.outRate * spec.oversampling;
+    rig["tension_n"] = tension;
+    rig["beta"] = beta;
+    rig["z0_kg_per_s"] = z0;
+    rig["sim_rate_hz"] = simRate;
+    reference::Simulator prototype = [&] {
+        try {
+            return reference::Simulator(r, beta, simRate);
+        } catch (const std::invalid_argument& e) {
+            throw LabError(std::string("synth-data: ") + e.what());
+        }
+    }();
+    rig["cells"] = prototype.grid().cells;
+
+    MeasurementSet set;
+    set.description = "simulated by rosin synth-data --generator reference (seed " + std::to_string(spec.seed) + ")";
+    set.stringName = "cello-D";
+    set.f0 = kManifestF0;
+    set.length = kManifestLength;
+    set.tension = kManifestTension;
+    set.z0 = kManifestTension / (2.0 * kManifestLength * kManifestF0);
+    set.beta = spec.beta;
+    set.exciter = "rod";
+    set.ambient = 20.0;
+    set.units = spec.units;
+    set.sampleRate = spec.outRate;
+    set.gesture = "guettler";
+    // The lab's own steady-sliding measurement of this rosin, 1 % scatter.
+    {
+        std::normal_distribution<double> g(0.0, 1.0);
+        std::mt19937_64 sr(spec.seed * 15485863ull + 3);
+        for (double v : {0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0})
+            set.steady.push_back({v, f.steady.mu(v) * (1.0 + 0.01 * g(sr)), f.contact.referenceLoad});
+    }
+    const Sensor sensor(rig["sensor_hz"], rig["sensor_q"], rig["highpass_hz"], simRate);
+    const double humPhase[3] = {2 * kPi * u(rng), 2 * kPi * u(rng), 2 * kPi * u(rng)};
+    const double humWeight[3] = {1.0, 0.5 * u(rng), 0.3 * u(rng)};
+    // Volts after the amplifier: the electrical artefacts come after the sensor.
+    auto record = [&](std::vector<double> x, std::size_t pre, std::mt19937_64& noiseRng) {
+        sensor.apply(x);
+        antiAliasFilter(x, 0.45 * spec.outRate, simRate);
+        const std::vector<double> y = resample(x, simRate, spec.outRate);
+        std::normal_distribution<double> g(0.0, 1.0);
+        std::vector<double> out(pre + y.size());
+        for (std::size_t i = 0; i < out.size(); ++i) {
+            const double t = static_cast<double>(i) / spec.outRate;
+            double hum = 0.0;
+            if (rig["hum_hz"] > 0)
+                for (int h = 0; h < 3; ++h) hum += rig["hum_n"] * humWeight[h] * std::sin(2 * kPi * rig["hum_hz"] * (h + 1) * t + humPhase[h]);
+            out[i] = (i < pre ? 0.0 : y[i - pre]) + hum + rig["dc_n"] + rig["noise_n"] * g(noiseRng);
+        }
+        return out;
+    };
+
+    const int n = spec.grid * spec.grid;
+    set.strokes.resize(static_cast<std::size_t>(n));
+    std::atomic<int> done{0};
+    std::mutex progressLock, truthLock;
+    tbb::parallel_for(0, n, [&](int k) {
+        std::mt19937_64 sr(spec.seed * 7919ull + static_cast<std::uint64_t>(k) + 11);
+        std::uniform_real_distribution<double> uu(0.0, 1.0);
+        const int ia = k % spec.grid, iF = k / spec.grid;
+        const double a = spec.aMin + (spec.aMax - spec.aMin) * ia / (spec.grid - 1);
+        const double F = spec.fMin + (spec.fMax - spec.fMin) * iF / (spec.grid - 1);
+        const double aTrue = a * (1.0 + spec.jitter * (2.0 * uu(sr) - 1.0));
+        const double fTrue = F * (1.0 + spec.jitter * (2.0 * uu(sr) - 1.0));
+        reference::Simulator sim = prototype;
+        std::vector<double> bridge(static_cast<std::size_t>(spec.seconds * simRate));
+        for (std::size_t i = 0; i < bridge.size(); ++i) bridge[i] = sim.step(fTrue, aTrue * static_cast<double>(i) / simRate).bridgeForce;
+        const double trigger = spec.triggerMax * uu(sr);
+        const auto pre = static_cast<std::size_t>(trigger * spec.outRate);
+        MeasuredStroke& m = set.strokes[static_cast<std::size_t>(k)];
+        char id[32];
+        std::snprintf(id, sizeof id, "a%02d_f%02d", ia, iF);
+        m.id = id;
+        m.accel = a;
+        m.force = F;
+        m.signal = record(std::move(bridge), pre, sr);
+        {
+            std::lock_guard<std::mutex> lock(truthLock);
+            truth.triggers[m.id] = static_cast<double>(pre) / spec.outRate;
+            truth.strokes[m.id] = {aTrue, fTrue};
+        }
+        const int finished = ++done;
+        if (progress && progressLock.try_lock()) {
+            progress(double(finished) / (n + spec.twoEnded));
+            progressLock.unlock();
+        }
+    });
+    set.twoEnded.resize(static_cast<std::size_t>(std::max(0, spec.twoEnded)));
+    tbb::parallel_for(0, spec.twoEnded, [&](int k) {
+        std::mt19937_64 sr(spec.seed * 104729ull + static_cast<std::uint64_t>(k) + 5);
+        TwoEndedRecording& rec = set.twoEnded[static_cast<std::size_t>(k)];
+        rec.id = "steady_" + std::to_string(k + 1);
+        rec.bowSpeed = 0.05 + 0.05 * k;
+        rec.force = 0.8;
+        reference::Simulator sim = prototype;
+        std::vector<double> b(static_cast<std::size_t>(0.4 * simRate)), far(b.size());
+        for (std::size_t i = 0; i < b.size(); ++i) {
+            const double t = static_cast<double>(i) / simRate;
+            const reference::Sample s = sim.step(rec.force, rec.bowSpeed * std::min(1.0, t / 0.03));
+            b[i] = s.bridgeForce;
+            far[i] = s.farEndForce;
+        }
+        rec.bridge = record(std::move(b), 0, sr);
+        rec.far = record(std::move(far), 0, sr);
+    });
+    // In volts the recordist set the gain from the loudest stroke; above full scale it clips.
+    truth.gain = 1.0;
+    if (spec.units == "V") {
+        double peak = 0.0;
+        for (const auto& m : set.strokes)
+            for (double v : m.signal) peak = std::max(peak, std::abs(v));
+        truth.gain = rig["headroom"] / peak;
+        std::size_t clipped = 0, total = 0;
+        auto scale = [&](std::vector<double>& x) {
+            for (double& v : x) {
+                v *= truth.gain;
+                if (std::abs(v) >= 0.999) {
+                    v = std::copysign(0.999, v);
+                    ++clipped;
+                }
+                ++total;
+            }
+        };
+        for (auto& m : set.strokes) scale(m.signal);
+        truth.clippedFraction = total ? static_cast<double>(clipped) / static_cast<double>(total) : 0.0;
+        for (auto& rec : set.twoEnded) {
+            scale(rec.bridge);
+            scale(rec.far);
+        }
+    }
+    return set;
+}
+
+} // namespace rosin::lab

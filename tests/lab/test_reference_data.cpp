@@ -1,0 +1,111 @@
+// `rosin synth-data --generator reference`: what goes into the set (only what a lab writes
+// down) and what goes into the truth (everything the rig drew).
+#include <gtest/gtest.h>
+#include <sndfile.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "rosin/lab/Error.h"
+#include "rosin/lab/Measurement.h"
+#include "rosin/lab/ReferenceData.h"
+
+using namespace rosin::lab;
+namespace fs = std::filesystem;
+
+namespace {
+SynthSpec small(std::uint64_t seed)
+{
+    SynthSpec s;
+    s.generator = "reference";
+    s.seed = seed;
+    s.grid = 2;
+    s.seconds = 0.06;
+    s.twoEnded = 1;
+    return s;
+}
+
+fs::path fresh(const std::string& name)
+{
+    const fs::path dir = fs::temp_directory_path() / ("rosin-refdata-" + std::to_string(::getpid()) + "-" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+} // namespace
+
+TEST(ReferenceSynthData, ManifestCarriesOnlyWhatALabWritesDown)
+{
+    SynthSpec spec = small(7);
+    spec.effects = {"hertzian_contact"};
+    SynthTruth truth;
+    const MeasurementSet set = synthesize(spec, truth);
+    const fs::path dir = fresh("manifest");
+    writeMeasurementSet(dir / "set", set, SF_FORMAT_FLOAT);
+    const MeasurementSet back = readMeasurementSet(dir / "set");
+    fs::remove_all(dir);
+    // Nominal values, not the rig's: the tension and bow position are off by a few percent.
+    EXPECT_DOUBLE_EQ(*back.tension, 102.6);
+    EXPECT_DOUBLE_EQ(back.beta, 0.0899);
+    EXPECT_NE(truth.rig.at("tension_n"), 102.6);
+    EXPECT_NEAR(truth.rig.at("tension_n") / 102.6 - 1.0, truth.rig.at("tension_error"), 1e-12);
+    EXPECT_NEAR(truth.rig.at("beta") / 0.0899 - 1.0, truth.rig.at("beta_error"), 1e-12);
+    for (const auto& s : back.strokes) EXPECT_FALSE(s.trigger.has_value()) << "the rig does not know its trigger";
+    // Every drawn rig value is in the truth, within its prior.
+    for (const RigPrior& p : referenceRigPriors()) {
+        ASSERT_TRUE(truth.rig.count(p.key)) << p.key;
+        if (p.key != "hum_hz" && p.key != "headroom") {
+            EXPECT_GE(truth.rig.at(p.key), p.lo) << p.key;
+            EXPECT_LE(truth.rig.at(p.key), p.hi) << p.key;
+        }
+    }
+    const auto [lo, hi] = referenceEffectPriors().at("load_exponent");
+    EXPECT_GE(truth.params.at("load_exponent"), lo);
+    EXPECT_LE(truth.params.at("load_exponent"), hi);
+    EXPECT_EQ(truth.strokes.size(), 4u);
+    // The lab's steady-sliding measurement comes back as written, and follows the rig's rosin.
+    ASSERT_EQ(back.steady.size(), set.steady.size());
+    for (std::size_t i = 0; i < back.steady.size(); ++i) EXPECT_NEAR(back.steady[i].mu, set.steady[i].mu, 1e-8);
+    EXPECT_NEAR(back.steady.front().mu / (1.2 * truth.rig.at("mu_level")), 1.0, 0.06);
+    ASSERT_EQ(back.twoEnded.size(), 1u);
+}
+
+TEST(ReferenceSynthData, FixedRigValuesAreKeptAndUnknownOnesRefused)
+{
+    SynthSpec spec = small(3);
+    spec.rig = {{"noise_n", 0.0}, {"hum_hz", 0.0}, {"dc_n", 0.0}, {"headroom", 1.3}};
+    SynthTruth truth;
+    const MeasurementSet set = synthesize(spec, truth);
+    EXPECT_EQ(truth.rig.at("noise_n"), 0.0);
+    EXPECT_EQ(truth.rig.at("hum_hz"), 0.0);
+    // Above full scale the recording clips at the converter's rails.
+    EXPECT_GT(truth.clippedFraction, 0.0);
+    double peak = 0;
+    for (const auto& s : set.strokes)
+        for (double v : s.signal) peak = std::max(peak, std::abs(v));
+    EXPECT_LE(peak, 0.999);
+    spec.rig = {{"noise", 0.01}};
+    EXPECT_THROW(synthesize(spec, truth), LabError);
+    spec = small(3);
+    spec.oversampling = 2;
+    EXPECT_THROW(synthesize(spec, truth), LabError);
+}
+
+TEST(ReferenceSynthData, BrokenSteadySlidingFileIsNamedWithItsLine)
+{
+    SynthTruth truth;
+    const MeasurementSet set = synthesize(small(5), truth);
+    const fs::path dir = fresh("steady");
+    writeMeasurementSet(dir / "set", set, SF_FORMAT_FLOAT);
+    std::ofstream(dir / "set" / "steady_sliding.csv") << "speed_m_s,mu\n0.01,0.9\n0.1,oops\n";
+    try {
+        readMeasurementSet(dir / "set");
+        ADD_FAILURE() << "a broken steady_sliding.csv was read";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("steady_sliding.csv:3"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("'mu'"), std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
+}
