@@ -42,6 +42,13 @@ Distributed::~Distributed()
 #endif
 }
 
+void Distributed::barrier() const
+{
+#ifdef ROSIN_HAVE_MPI
+    if (active_) MPI_Barrier(MPI_COMM_WORLD);
+#endif
+}
+
 void Distributed::combine(std::vector<CellResult>& results, std::atomic<long long>& samples) const
 {
     if (!active_) return;

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <fstream>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "rosin/lab/Error.h"
@@ -50,6 +52,22 @@ dsp::BowedStringConfig modelWithEffects(const std::vector<std::string>& effects,
         c.string.torsionImpedanceRatio = param("zt_ratio", 2.0);
     }
     return c;
+}
+
+void writeTruth(const std::filesystem::path& file, const SynthTruth& truth, std::uint64_t seed)
+{
+    nlohmann::json t{{"format", "rosin-synth-truth/1"}, {"generator", truth.generator}, {"effects", truth.effects},
+                     {"params", truth.params}, {"gain_units_per_N", truth.gain}, {"seed", seed}, {"triggers_s", truth.triggers}};
+    if (truth.generator == "reference") {
+        t["rig"] = truth.rig;
+        t["clipped_fraction"] = truth.clippedFraction;
+        nlohmann::json strokes;
+        for (const auto& [id, af] : truth.strokes) strokes[id] = {{"accel_m_s2", af.first}, {"force_n", af.second}};
+        t["strokes"] = strokes;
+    }
+    std::ofstream out(file);
+    out << t.dump(1) << "\n";
+    if (!out) throw LabError(file.string() + ": cannot write");
 }
 
 MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress)

@@ -24,7 +24,7 @@ int main(int argc, char** argv)
     const std::vector<Command> commands{addRenderCommand(app),   addStringsCommand(app),  addBenchCommand(app),
                                         addGuettlerCommand(app), addPanelCommand(app),    addClassifyCommand(app),
                                         addDiagnoseCommand(app), addSynthDataCommand(app), addFiguresCommand(app),
-                                        addPlayabilityCommand(app)};
+                                        addPlayabilityCommand(app), addStudyCommand(app)};
 
     if (argc > 1 && argv[1][0] != '-') {
         bool known = false;

@@ -163,6 +163,7 @@ Command addPanelCommand(CLI::App& app);
 Command addClassifyCommand(CLI::App& app);
 Command addDiagnoseCommand(CLI::App& app);
 Command addSynthDataCommand(CLI::App& app);
+Command addStudyCommand(CLI::App& app);
 Command addFiguresCommand(CLI::App& app);
 Command addPlayabilityCommand(CLI::App& app);
 

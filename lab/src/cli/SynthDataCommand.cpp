@@ -107,19 +107,7 @@ struct SynthDataCommand {
         progress.finish();
         OutputSet outputs;
         const fs::path truthTmp = outputs.add(synthOut + ".truth.json");
-        {
-            nlohmann::json t{{"format", "rosin-synth-truth/1"}, {"generator", truth.generator}, {"effects", truth.effects},
-                             {"params", truth.params}, {"gain_units_per_N", truth.gain}, {"seed", synth.seed},
-                             {"triggers_s", truth.triggers}};
-            if (truth.generator == "reference") {
-                t["rig"] = truth.rig;
-                t["clipped_fraction"] = truth.clippedFraction;
-                nlohmann::json strokes;
-                for (const auto& [id, af] : truth.strokes) strokes[id] = {{"accel_m_s2", af.first}, {"force_n", af.second}};
-                t["strokes"] = strokes;
-            }
-            std::ofstream(truthTmp) << t.dump(1) << "\n";
-        }
+        writeTruth(truthTmp, truth, synth.seed);
         writeMeasurementSet(synthOut, set, formats.at(wavKind));
         outputs.commit();
         if (!synthQuiet)

@@ -19,6 +19,8 @@ public:
     bool active() const { return active_; }
     /// Gathers every rank's results (and sample counts) into every rank.
     void combine(std::vector<CellResult>& results, std::atomic<long long>& samples) const;
+    /// Waits until every rank has reached this point (a no-op in one process).
+    void barrier() const;
     ~Distributed();
 
 private:

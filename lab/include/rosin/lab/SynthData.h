@@ -58,6 +58,10 @@ struct SynthTruth {
     double clippedFraction = 0.0;           ///< share of samples at full scale
 };
 
+/// OUT.truth.json (rosin-synth-truth/1): the hidden effects and parameters, the gain, the
+/// triggers and, for reference sets, every drawn rig value and each stroke's true gesture.
+void writeTruth(const std::filesystem::path& file, const SynthTruth& truth, std::uint64_t seed);
+
 /// Simulates the set (all cores) and returns it with the hidden truth.
 MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress = {});
 

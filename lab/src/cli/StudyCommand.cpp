@@ -1,0 +1,64 @@
+// `rosin study`.
+#include "Cli.h"
+
+#include <cstdio>
+#include <memory>
+
+#include "rosin/lab/Distributed.h"
+#include "rosin/lab/Output.h"
+#include "rosin/lab/Study.h"
+
+namespace rosin::cli {
+
+namespace {
+
+struct StudyCommand {
+    StudyOptions options;
+    std::string out = "study";
+    bool scoreOnly = false;
+
+    CLI::App* add(CLI::App& app)
+    {
+        CLI::App* cmd = app.add_subcommand("study", "Diagnose many reference sets (data the model did not make) and score the "
+                                                    "findings against what was hidden");
+        cmd->footer("Writes OUT/sets/NNN/{truth.json, diagnosis/}, then OUT/study.csv, study.json, summary.md and study.png:\n"
+                    "detection per effect, false positives (null sets and per effect), parameter error, coverage of\n"
+                    "the 95 % intervals, detection against effect size. An interrupted study resumes where it\n"
+                    "stopped. Minutes per set: run by hand, not in CI. Under mpirun the sets are dealt to ranks.");
+        cmd->add_option("-o,--out", out, "Study folder (created, or resumed)")->capture_default_str();
+        cmd->add_option("--sets", options.sets, "Number of sets (a real study: 30 or more)")->check(CLI::Range(1, 1000))->capture_default_str();
+        cmd->add_option("--nulls", options.nulls, "Of which with nothing hidden")->check(CLI::Range(0, 1000))->capture_default_str();
+        cmd->add_option("--grid", options.grid, "Strokes per axis of each set")->check(CLI::Range(3, 30))->capture_default_str();
+        cmd->add_option("--seed", options.seed, "Seed of the plan and of every set")->capture_default_str();
+        cmd->add_option("--oversampling", options.oversampling, "Reference simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
+        cmd->add_option("--diagnose-seed", options.diagnose.seed, "Seed of each diagnosis's split and bootstraps")->capture_default_str();
+        cmd->add_flag("--keep-sets", options.keepSets, "Keep the generated WAV sets");
+        cmd->add_flag("--score-only", scoreOnly, "Only score what OUT already holds");
+        cmd->add_flag("-q,--quiet", options.quiet, "No progress and no summary");
+        return cmd;
+    }
+
+    int run()
+    {
+        if (!scoreOnly) {
+            Progress progress("study", !options.quiet && Distributed::instance().isRoot());
+            runStudy(out, options, [&](const std::string&, double x) { progress.update(x); });
+            progress.finish();
+        }
+        if (!Distributed::instance().isRoot()) return 0;
+        const std::string summary = scoreStudy(out);
+        if (!options.quiet) std::printf("%s\nwrote %s/study.csv, study.json, summary.md, study.png\n", summary.c_str(), out.c_str());
+        return 0;
+    }
+};
+
+} // namespace
+
+Command addStudyCommand(CLI::App& app)
+{
+    auto command = std::make_shared<StudyCommand>();
+    CLI::App* sub = command->add(app);
+    return {sub, [command] { return command->run(); }};
+}
+
+} // namespace rosin::cli
