@@ -23,6 +23,8 @@ enum class FrictionModel {
 struct FrictionParams {
     FrictionModel model = FrictionModel::Thermal;
     SteadyFit fit = SteadyFit::SmithWoodhouse;
+    std::optional<SteadyCurve> steadyCurve; ///< a measured curve; overrides `fit` when set
+    SteadyCurve effectiveSteadyCurve() const noexcept { return steadyCurve ? *steadyCurve : SteadyCurve::of(fit); }
     SpeedFunction speedFunction = SpeedFunction::Rod;
     std::optional<SpeedLaw> speedLaw; ///< overrides the preset speedFunction when set
     SpeedLaw effectiveSpeedLaw() const noexcept { return speedLaw ? *speedLaw : SpeedLaw::of(speedFunction); }
@@ -54,10 +56,11 @@ public:
         params_ = params;
         area_.configure(params.contactLaw, params.contactExponent, params.thermal);
         speed_ = params.effectiveSpeedLaw();
+        steady_ = params.effectiveSteadyCurve();
         const bool both = params.switchable;
-        if (both || params.model == FrictionModel::Thermal) thermalLaw_.build(params.fit, std::nullopt, params.thermal);
+        if (both || params.model == FrictionModel::Thermal) thermalLaw_.build(params.effectiveSteadyCurve(), std::nullopt, params.thermal);
         if (both || params.model == FrictionModel::Enhanced)
-            enhancedLaw_.build(params.fit, std::optional<SpeedLaw>(speed_), params.thermal);
+            enhancedLaw_.build(params.effectiveSteadyCurve(), std::optional<SpeedLaw>(speed_), params.thermal);
         applyShiftAndScale();
         thermal_.prepare(sampleRate, params.thermal);
         muAtRest_ = speedLaw(0.0).mu;
@@ -172,7 +175,7 @@ public:
     {
         const double load = area_.effectiveLoad(fb);
         switch (params_.model) {
-        case FrictionModel::FrictionCurve: return load * steadySliding(params_.fit, 0.0).mu;
+        case FrictionModel::FrictionCurve: return load * steady_(0.0).mu;
         case FrictionModel::Thermal: return load * law()(theta);
         case FrictionModel::Enhanced: return load * law()(theta) * speed_(0.0).mu;
         }
@@ -182,7 +185,7 @@ public:
     /// mu(x) at zero temperature scale; the speed law used with the jump rule.
     MuSlope speedLaw(double x) const noexcept
     {
-        return params_.model == FrictionModel::Enhanced ? speed_(x) : steadySliding(params_.fit, x);
+        return params_.model == FrictionModel::Enhanced ? speed_(x) : steady_(x);
     }
 
     ContactState state() const noexcept { return state_; }
@@ -419,6 +422,7 @@ private:
     ContactState state_ = ContactState::Stick;
     double xPrev_ = 0.0, heatPerLoadPrev_ = 0.0, slidePrev_ = 0.0, heatSlopePerLoadPrev_ = 0.0;
     SpeedLaw speed_;
+    SteadyCurve steady_;
     double muAtRest_ = 1.0, forceCached_ = -1.0, loadCached_ = 0.0, invLoadCached_ = 0.0;
     double zEffCached_ = -1.0, twoZ_ = 1.0, invTwoZ_ = 0.0;
     double noiseLevel_ = 0.0;

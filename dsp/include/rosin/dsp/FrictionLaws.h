@@ -17,16 +17,40 @@ enum class SteadyFit {
     WoodhouseGalluzzo ///< 0.2 (v + 0.011)^{-0.4}, decays to zero at high speed [WG25 eq. 13]
 };
 
-inline MuSlope steadySliding(SteadyFit fit, double x) noexcept
-{
-    x = std::abs(x);
-    if (fit == SteadyFit::SmithWoodhouse) {
-        const double e1 = std::exp(-x / 0.01), e2 = std::exp(-x / 0.1);
-        return {0.4 * e1 + 0.45 * e2 + 0.35, -40.0 * e1 - 4.5 * e2};
+/// A steady-sliding curve with its coefficients as fields: one of the two published fits, or a
+/// rig's own measured curve (diagnosis fits it to a set's steady_sliding.csv).
+struct SteadyCurve {
+    SteadyFit shape = SteadyFit::SmithWoodhouse;
+    double a1 = 0.4, v1 = 0.01, a2 = 0.45, v2 = 0.1, a3 = 0.35; ///< a1 e^{-v/v1} + a2 e^{-v/v2} + a3
+    double k1 = 40.0, k2 = 4.5;                                 ///< a1/v1, a2/v2 (the slope's factors)
+    double c = 0.2, v0 = 0.011, p = 0.4;                        ///< c (v + v0)^{-p}
+
+    static SteadyCurve of(SteadyFit fit) noexcept
+    {
+        SteadyCurve s;
+        s.shape = fit;
+        return s;
     }
-    const double p = std::pow(x + 0.011, -0.4);
-    return {0.2 * p, -0.4 * 0.2 * p / (x + 0.011)};
-}
+    /// Smith-Woodhouse shape with the rig's coefficients.
+    static SteadyCurve exponentials(double a1, double v1, double a2, double v2, double a3) noexcept
+    {
+        SteadyCurve s;
+        s.a1 = a1, s.v1 = v1, s.a2 = a2, s.v2 = v2, s.a3 = a3, s.k1 = a1 / v1, s.k2 = a2 / v2;
+        return s;
+    }
+    MuSlope operator()(double x) const noexcept
+    {
+        x = std::abs(x);
+        if (shape == SteadyFit::SmithWoodhouse) {
+            const double e1 = std::exp(-x / v1), e2 = std::exp(-x / v2);
+            return {a1 * e1 + a2 * e2 + a3, -k1 * e1 - k2 * e2};
+        }
+        const double q = std::pow(x + v0, -p);
+        return {c * q, -p * c * q / (x + v0)};
+    }
+};
+
+inline MuSlope steadySliding(SteadyFit fit, double x) noexcept { return SteadyCurve::of(fit)(x); }
 
 enum class SpeedFunction {
     Bow, ///< h_bow = 0.5 (v + 0.27)^{-0.4}   [WG25 eq. 14]

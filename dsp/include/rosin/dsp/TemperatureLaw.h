@@ -27,14 +27,15 @@ class TemperatureLaw {
 public:
     /// [setup thread] Builds the table. With a speed function it tabulates y = mu_ss / h
     /// (enhanced model); without, mu_ss itself (original thermal model).
-    void build(SteadyFit fit, std::nullopt_t, const ThermalParams& tp) { build(fit, std::optional<SpeedLaw>(), tp); }
+    void build(SteadyFit fit, std::nullopt_t, const ThermalParams& tp) { build(SteadyCurve::of(fit), std::optional<SpeedLaw>(), tp); }
+    void build(const SteadyCurve& fit, std::nullopt_t, const ThermalParams& tp) { build(fit, std::optional<SpeedLaw>(), tp); }
 
     void build(SteadyFit fit, std::optional<SpeedFunction> speed, const ThermalParams& tp)
     {
-        build(fit, speed ? std::optional<SpeedLaw>(SpeedLaw::of(*speed)) : std::nullopt, tp);
+        build(SteadyCurve::of(fit), speed ? std::optional<SpeedLaw>(SpeedLaw::of(*speed)) : std::nullopt, tp);
     }
 
-    void build(SteadyFit fit, std::optional<SpeedLaw> speed, const ThermalParams& tp)
+    void build(const SteadyCurve& fit, std::optional<SpeedLaw> speed, const ThermalParams& tp)
     {
         // Dense log grid of speeds; stop at the first maximum of theta_ss (beyond it the
         // inversion is not single-valued: clamp there, PHYSICS.md 3.5 step 3).
@@ -43,7 +44,7 @@ public:
         const int n = 6000;
         for (int i = 0; i <= n; ++i) {
             const double v = std::pow(10.0, -8.0 + 9.0 * i / n); // 1e-8 .. 10 m/s
-            const double th = steadyTemperature(v, steadySliding(fit, v).mu, tp);
+            const double th = steadyTemperature(v, fit(v).mu, tp);
             if (th <= thetas.back()) break;
             thetas.push_back(th);
             values.push_back(valueAt(fit, speed, v));
@@ -116,9 +117,9 @@ public:
     double thetaMax() const noexcept { return thetaMax_; }
 
 private:
-    static double valueAt(SteadyFit fit, const std::optional<SpeedLaw>& speed, double v) noexcept
+    static double valueAt(const SteadyCurve& fit, const std::optional<SpeedLaw>& speed, double v) noexcept
     {
-        const double mu = steadySliding(fit, v).mu;
+        const double mu = fit(v).mu;
         return speed ? mu / (*speed)(v).mu : mu;
     }
 
