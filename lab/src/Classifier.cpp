@@ -115,7 +115,12 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
     }
     double bestResidual = 1e300;
     const double stiffness = in.tension / (in.beta * in.length);
-    for (double hum : {50.0, 60.0}) {
+    // Hum is taken out only where the recording shows it: each candidate (none, 50, 60 Hz)
+    // pays for its parameters (BIC), so a clean ramp is not bent by a fitted hum and a DC.
+    std::vector<double> hums{0.0, 50.0, 60.0};
+    if (in.hum >= 0.0) hums = {in.hum};
+    for (double hum : hums) {
+        const int harmonics = hum > 0.0 ? 4 : 0;
         // Trigger search: coarse grid over the pre-slip time, then refined around the best.
         double lo = 0.0, hi = end / fs, bestT0 = 0.0;
         for (int pass = 0; pass < 3; ++pass) {
@@ -124,11 +129,11 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
             for (int s = 0; s <= steps; ++s) {
                 const double t0 = lo + (hi - lo) * s / steps;
                 const auto xb = bowDisplacement(in.bowSpeed, fs, end, t0);
-                std::vector<std::vector<double>> cols(2 + 8, std::vector<double>(static_cast<std::size_t>(end)));
+                std::vector<std::vector<double>> cols(2 + 2 * harmonics, std::vector<double>(static_cast<std::size_t>(end)));
                 for (int i = 0; i < end; ++i) {
                     cols[0][i] = 1.0;
                     cols[1][i] = stiffness * xb[i];
-                    for (int h = 1; h <= 4; ++h) {
+                    for (int h = 1; h <= harmonics; ++h) {
                         cols[2 * h][i] = std::sin(2 * std::numbers::pi * hum * h * i / fs);
                         cols[2 * h + 1][i] = std::cos(2 * std::numbers::pi * hum * h * i / fs);
                     }
@@ -152,16 +157,17 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
                     for (std::size_t k = 0; k < cols.size(); ++k) model += c[k] * cols[k][i];
                     r += (y[i] - model) * (y[i] - model);
                 }
+                const double bic = end * std::log(std::max(r, 1e-300) / end) + static_cast<double>(cols.size()) * std::log(static_cast<double>(end));
                 if (r < passBest) { passBest = r; passT0 = t0; }
-                if (r < bestResidual && c[1] > 0.0) {
-                    bestResidual = r;
+                if (bic < bestResidual && c[1] > 0.0) {
+                    bestResidual = bic;
                     best.gain = c[1];
                     best.dc = c[0];
                     best.trigger = t0;
                     best.hum = hum;
                     best.humWave.assign(static_cast<std::size_t>(n), 0.0);
                     for (int i = 0; i < n; ++i)
-                        for (int h = 1; h <= 4; ++h)
+                        for (int h = 1; h <= harmonics; ++h)
                             best.humWave[i] += c[2 * h] * std::sin(2 * std::numbers::pi * hum * h * i / fs)
                                                + c[2 * h + 1] * std::cos(2 * std::numbers::pi * hum * h * i / fs);
                 }
@@ -270,7 +276,9 @@ Classification classify(const ClassifierInput& in, const ClassifierSettings& st)
         for (int i = 0; i < n && i < static_cast<int>(in.stick.size()); ++i)
             if (!in.stick[i]) { slip = i; break; }
     } else {
-        slip = firstRelativeDrop(f, 0.0, window01, st.slipFloor);
+        int from = 0;
+        while (from < n && f[from] < st.minSlipForce) ++from;
+        slip = from < n ? firstRelativeDrop(f, 0.0, window01, st.slipFloor, from) : -1;
     }
     if (slip < 1) {
         out.regime = Regime::NoSlip;

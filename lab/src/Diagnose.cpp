@@ -1,5 +1,6 @@
 #include "rosin/lab/Diagnose.h"
 
+#include <Eigen/Dense>
 #include <nlopt.hpp>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -9,9 +10,11 @@
 #include <memory>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <set>
 
+#include "DiagnoseEngine.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Resample.h"
 #include "rosin/lab/Schumacher.h"
@@ -34,138 +37,30 @@ std::string EffectModel::name() const
 
 namespace {
 
-struct StringInfo {
-    double f0, beta, z0, tension, length;
-};
-
-struct Prepared {
-    std::string id;
-    double a = 0, F = 0;
-    std::vector<double> force; ///< N at the diagnosis rate, t = 0 at the gesture start
-    StrokeFeatures feat;
-};
-
-constexpr double kCompareCutoff = 5000.0; // both signals see the same low-pass before comparison
-
-/// Noise of a low-passed recording: the robust spread of its sample-to-sample steps.
-double noiseLevel(const std::vector<double>& f)
-{
-    if (f.size() < 3) return 0.0;
-    std::vector<double> d(f.size() - 1);
-    for (std::size_t i = 1; i < f.size(); ++i) d[i - 1] = std::abs(f[i] - f[i - 1]);
-    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    return 1.4826 * d[d.size() / 2] / std::sqrt(2.0);
-}
-
-StrokeFeatures features(std::vector<double> f, double fs, double a, double F, const StringInfo& s, bool recorded = false)
-{
-    zeroPhaseLowPass(f, kCompareCutoff, fs);
-    const ClassifierInput in = guettlerStrokeInput(f, fs, s.f0, s.beta, s.z0, s.tension, s.length, a);
-    ClassifierSettings st;
-    // A first slip drops the force by more than 2 % of the bow force, and in a recording by
-    // clearly more than its noise can within 0.1 ms.
-    st.slipFloor = std::max(0.02 * F, recorded ? 6.0 * noiseLevel(f) : 0.0);
-    const Classification c = classify(in, st);
-    StrokeFeatures r;
-    r.firstSlip = c.firstSlipTime;
-    r.forceBeforeSlip = c.forceBeforeSlip;
-    r.firstDrop = c.firstDrop;
-    r.transientPeriods = c.transientPeriods;
-    r.regime = c.regime;
-    if (c.firstSlipTime > 0) {
-        const auto start = static_cast<std::size_t>(c.firstSlipTime * fs);
-        const auto len = static_cast<std::size_t>(2.0 * fs / s.f0);
-        for (std::size_t i = start; i < start + len && i < f.size(); ++i) r.wave.push_back(f[i]);
-    }
-    return r;
-}
-
-ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, double a, double F, const StringInfo& info)
-{
-    ErrorParts e;
-    if (m.firstSlip < 0 && s.firstSlip < 0) return e;
-    if (m.firstSlip < 0 || s.firstSlip < 0) return {1, 1, 1, 1, 1};
-    e.firstSlip = std::min(1.0, std::abs(s.firstSlip - m.firstSlip) / m.firstSlip);
-    e.forceBeforeSlip = std::min(1.0, std::abs(s.forceBeforeSlip - m.forceBeforeSlip) / F);
-    e.jump = std::min(1.0, std::abs(s.firstDrop - m.firstDrop) / F);
-    const double nm = m.transientPeriods < 0 ? 30 : m.transientPeriods, ns = s.transientPeriods < 0 ? 30 : s.transientPeriods;
-    e.transient = std::min(1.0, std::abs(nm - ns) / 25.0);
-    const std::size_t n = std::min(m.wave.size(), s.wave.size());
-    if (n > 0) {
-        double acc = 0;
-        for (std::size_t i = 0; i < n; ++i) acc += (m.wave[i] - s.wave[i]) * (m.wave[i] - s.wave[i]);
-        const double flyback = 2.0 * info.z0 * a * m.firstSlip / info.beta;
-        e.waveform = std::min(1.0, std::sqrt(acc / static_cast<double>(n)) / std::max(flyback, 1e-9));
-    }
-    return e;
-}
-
-class Engine {
-public:
-    Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs) : strokes_(strokes), info_(info), fs_(fs) {}
-
-    /// Simulated features of stroke i under model m (optionally the first 12 periods of force).
-    StrokeFeatures simulate(const EffectModel& m, std::size_t i, std::vector<double>* head = nullptr) const
-    {
-        // One prepared voice per thread, kept while the model stays the same (all the strokes of
-        // one evaluation): reset() restores it exactly, prepare() would rebuild its tables.
-        Voice& v = voices_.local();
-        if (!v.string || v.model.effects != m.effects || v.model.params != m.params) {
-            dsp::BowedStringConfig c = modelWithEffects(m.effects, m.params);
-            c.string.length = info_.length;
-            c.string.tension = info_.tension;
-            c.string.massPerLength = info_.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
-            if (!v.string) v.string = std::make_unique<dsp::BowedString<double>>();
-            v.string->prepare(fs_, c);
-            v.model = m;
-        } else {
-            v.string->reset();
-        }
-        dsp::BowedString<double>& s = *v.string;
-        const Prepared& p = strokes_[i];
-        std::vector<double> out(p.force.size());
-        for (std::size_t n = 0; n < out.size(); ++n) out[n] = s.processSample(p.F, p.a * static_cast<double>(n) / fs_, info_.beta);
-        ++simulations_;
-        if (head) head->assign(out.begin(), out.begin() + static_cast<long>(std::min(out.size(), static_cast<std::size_t>(12.0 * fs_ / info_.f0 + 0.02 * fs_))));
-        return features(std::move(out), fs_, p.a, p.F, info_);
-    }
-
-    std::vector<ErrorParts> errors(const EffectModel& m, const std::vector<std::size_t>& which) const
-    {
-        std::vector<ErrorParts> e(which.size());
-        tbb::parallel_for(std::size_t(0), which.size(), [&](std::size_t k) {
-            const std::size_t i = which[k];
-            e[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].a, strokes_[i].F, info_);
-        });
-        return e;
-    }
-
-    static double mean(const std::vector<ErrorParts>& e)
-    {
-        double s = 0;
-        for (const auto& x : e) s += x.total();
-        return e.empty() ? 0.0 : s / static_cast<double>(e.size());
-    }
-
-    long long simulations() const { return simulations_.load(); }
-
-private:
-    struct Voice {
-        EffectModel model;
-        std::unique_ptr<dsp::BowedString<double>> string;
-    };
-    std::vector<Prepared>& strokes_;
-    StringInfo info_;
-    double fs_;
-    mutable std::atomic<long long> simulations_{0};
-    mutable tbb::enumerable_thread_specific<Voice> voices_;
-};
+using namespace diag;
 
 struct Candidate {
     std::string effect;
     std::vector<std::string> adds, names;
     std::vector<double> lo, hi, start;
+    std::size_t scanned = 0; ///< the grid covers the first `scanned` parameters (0: all); the rest start where they are
 };
+
+/// The candidate with the model's nuisances free beside its own parameters: an effect has to
+/// beat a model whose calibration could move too (a rolling string looks a little like a
+/// softer one, and must not be absorbed by the tension before torsion is tried).
+Candidate withNuisances(Candidate c, const EffectModel& m)
+{
+    c.scanned = c.names.size();
+    for (const char* k : {"tension_scale", "beta_scale"})
+        if (m.params.count(k)) {
+            c.names.push_back(k);
+            c.lo.push_back(k[0] == 't' ? 0.95 : 0.96);
+            c.hi.push_back(k[0] == 't' ? 1.05 : 1.04);
+            c.start.push_back(m.params.at(k));
+        }
+    return c;
+}
 
 std::vector<Candidate> candidates(const EffectModel& m)
 {
@@ -196,7 +91,8 @@ const std::map<std::string, std::pair<double, double>>& parameterBounds()
 {
     static const std::map<std::string, std::pair<double, double>> b{{"r_A", {0.5, 2.0}},          {"h0", {0.3, 1.2}},
                                                                       {"p", {0.1, 0.8}},            {"load_exponent", {0.4, 1.1}},
-                                                                      {"shift_k", {-30.0, 30.0}},   {"zt_ratio", {0.7, 8.0}}};
+                                                                      {"shift_k", {-30.0, 30.0}},   {"zt_ratio", {0.7, 8.0}},
+                                                                      {"tension_scale", {0.95, 1.05}}, {"beta_scale", {0.96, 1.04}}};
     return b;
 }
 
@@ -220,7 +116,8 @@ std::string effectOf(const std::string& parameter)
     if (parameter == "h0" || parameter == "p") return "rate_dependence";
     if (parameter == "load_exponent") return "hertzian_contact";
     if (parameter == "shift_k") return "rosin_temperature_shift";
-    return "torsional_compliance";
+    if (parameter == "zt_ratio") return "torsional_compliance";
+    return "calibration";
 }
 
 EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x)
@@ -235,32 +132,33 @@ EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector
 /// Fits the candidate's parameters on the given strokes. The error surface is rough (transients
 /// are chaotic), so a coarse grid over the bounds comes first and COBYLA refines from its best
 /// point on [0, 1]-scaled variables. `scan` = false skips the grid (warm starts).
-std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<std::size_t>& on,
+std::vector<double> fit(const diag::Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<std::size_t>& on,
                         std::vector<double> start, int maxEval, double step, double* best = nullptr, bool scan = true)
 {
     const std::size_t n = c.names.size();
     std::vector<double> x(n);
     for (std::size_t k = 0; k < n; ++k) x[k] = (start[k] - c.lo[k]) / (c.hi[k] - c.lo[k]);
     if (scan) {
-        const int per = n == 1 ? 7 : n == 2 ? 5 : 3;
+        const std::size_t ns = c.scanned > 0 ? c.scanned : n;
+        const int per = ns == 1 ? 7 : ns == 2 ? 5 : 3;
         int total = 1;
-        for (std::size_t k = 0; k < n; ++k) total *= per;
+        for (std::size_t k = 0; k < ns; ++k) total *= per;
         double bestGrid = 1e300;
         for (int g = 0; g < total; ++g) {
-            std::vector<double> u(n), v(n);
+            std::vector<double> u = x, v(n);
             int rest = g;
-            for (std::size_t k = 0; k < n; ++k) {
+            for (std::size_t k = 0; k < ns; ++k) {
                 u[k] = (rest % per + 0.5) / per;
                 rest /= per;
-                v[k] = c.lo[k] + u[k] * (c.hi[k] - c.lo[k]);
             }
-            const double e = Engine::mean(engine.errors(apply(base, c, v), on));
+            for (std::size_t k = 0; k < n; ++k) v[k] = c.lo[k] + u[k] * (c.hi[k] - c.lo[k]);
+            const double e = diag::mean(engine.errors(apply(base, c, v), on));
             if (e < bestGrid) { bestGrid = e; x = u; }
         }
         step = 0.5 / per;
     }
     struct Ctx {
-        const Engine* engine;
+        const diag::Engine* engine;
         const EffectModel* base;
         const Candidate* c;
         const std::vector<std::size_t>* on;
@@ -269,7 +167,7 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
         const Ctx& k = *static_cast<Ctx*>(data);
         std::vector<double> v(u.size());
         for (std::size_t i = 0; i < u.size(); ++i) v[i] = k.c->lo[i] + std::clamp(u[i], 0.0, 1.0) * (k.c->hi[i] - k.c->lo[i]);
-        return Engine::mean(k.engine->errors(apply(*k.base, *k.c, v), *k.on));
+        return diag::mean(k.engine->errors(apply(*k.base, *k.c, v), *k.on));
     };
     nlopt::opt opt(nlopt::LN_COBYLA, static_cast<unsigned>(n));
     opt.set_lower_bounds(std::vector<double>(n, 0.0));
@@ -309,44 +207,30 @@ std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const st
     return {mean, means[static_cast<std::size_t>(0.025 * B)], means[static_cast<std::size_t>(0.975 * B)]};
 }
 
-std::string describe(const std::string& effect, const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after,
-                     const std::vector<std::size_t>& ids, const EffectModel& from, double errBefore, double errAfter)
+
+
+
+/// The no-effect value of an effect's parameter, which its interval must exclude to be named
+/// (thermal memory has none: its law differs from the friction curve in kind).
+bool intervalAtNull(const std::string& name, double lo, double hi)
 {
-    // The part of the comparison the extension mended most, weighted as in the metric.
-    const char* names[] = {"first-slip times", "bridge forces before the first slip", "first-slip jumps", "transient lengths",
-                           "waveforms just after the first slip"};
-    const double weights[] = {0.25, 0.25, 0.25, 0.10, 0.15};
-    double b[5] = {0, 0, 0, 0, 0}, a[5] = {0, 0, 0, 0, 0};
-    for (std::size_t i = 0; i < before.size(); ++i) {
-        const double pb[] = {before[i].firstSlip, before[i].forceBeforeSlip, before[i].jump, before[i].transient, before[i].waveform};
-        const double pa[] = {after[i].firstSlip, after[i].forceBeforeSlip, after[i].jump, after[i].transient, after[i].waveform};
-        for (int k = 0; k < 5; ++k) { b[k] += pb[k]; a[k] += pa[k]; }
-    }
-    const double m = static_cast<double>(std::max<std::size_t>(1, before.size()));
-    int top = 0;
-    for (int k = 1; k < 5; ++k)
-        if (weights[k] * (b[k] - a[k]) > weights[top] * (b[top] - a[top])) top = k;
-    const char* unit[] = {" of the measured time", " of the bow force", " of the bow force", " of 25 periods", " of the ideal flyback"};
-    static const std::map<std::string, std::string> meaning{
-        {"thermal_memory", "friction follows the contact temperature, which remembers past slipping"},
-        {"rate_dependence", "on top of temperature, friction falls with sliding speed"},
-        {"hertzian_contact", "friction is not proportional to bow force: one smooth contact whose area grows slower than the force"},
-        {"rosin_temperature_shift", "the rosin softens at another temperature than the reference violin rosin"},
-        {"torsional_compliance", "the string rolls under the bow"}};
-    char buf[700];
-    std::snprintf(buf, sizeof buf,
-                  "With the %s model the %s of the %zu held-out strokes were off by %.1f %%%s on average; they are off by %.1f %% "
-                  "when %s. Held-out error %.3f -> %.3f.",
-                  from.name().c_str(), names[top], ids.size(), 100.0 * b[top] / m, unit[top], 100.0 * a[top] / m,
-                  meaning.at(effect).c_str(), errBefore, errAfter);
-    return buf;
+    if (name == "load_exponent") return hi >= 1.0;
+    if (name == "shift_k") return lo <= 0.0 && hi >= 0.0;
+    if (name == "zt_ratio") return hi >= 7.5; // the torsion of a string rolling less than Z_t = 7.5 Z0 is not seen
+    if (name == "p") return lo <= 0.03;
+    return false;
 }
 
-double median(std::vector<double> v)
+std::vector<std::size_t> subset(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes, bool upper)
 {
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
+    std::vector<double> a;
+    for (auto i : from) a.push_back(strokes[i].a);
+    std::sort(a.begin(), a.end());
+    const double mid = a[a.size() / 2];
+    std::vector<std::size_t> out;
+    for (auto i : from)
+        if ((strokes[i].a >= mid) == upper) out.push_back(i);
+    return out;
 }
 
 } // namespace
@@ -368,114 +252,87 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
     if (set.gesture != "guettler") throw LabError(set.folder.string() + ": diagnose handles gesture.kind \"guettler\" sets for now");
 
-    // 1. Clean every recording and find its gesture start; one gain for the whole set.
+    // 1. Clean every recording, find its gesture start, convert the set to newtons.
     say("preparing", 0.0);
-    const std::size_t n = set.strokes.size();
-    std::vector<Calibration> cal(n);
-    // knownGain 0: gain fitted per recording.
-    auto recording = [&](std::size_t i, double knownGain) {
-        const MeasuredStroke& s = set.strokes[i];
-        ClassifierInput in = guettlerStrokeInput(s.signal, set.sampleRate, info.f0, info.beta, info.z0, info.tension, info.length, s.accel);
-        in.measured = true;
-        in.knownGain = knownGain;
-        return in;
-    };
-    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-        cal[i] = calibrateRecording(recording(i, 0.0));
-        if (set.strokes[i].trigger) cal[i].trigger = *set.strokes[i].trigger;
-    });
-    std::vector<double> gains, allGains;
-    int unfitted = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (cal[i].firstSlip < 0) continue;
-        if (!cal[i].rampFitted) {
-            ++unfitted;
-            continue;
-        }
-        allGains.push_back(cal[i].gain);
-        // The ramp gives the gain only once the string is quasi-statically deflected.
-        if (cal[i].firstSlip / set.sampleRate - cal[i].trigger > 4.0 / info.f0) gains.push_back(cal[i].gain);
-    }
-    // The gesture starts were estimated, not taken as the file starts, when any ramp fitted.
-    d.triggersDetected = !allGains.empty();
-    if (unfitted > 0)
-        d.warnings.push_back(std::to_string(unfitted) + " stroke(s) slipped before a pre-slip ramp could be fitted: their gesture start is taken as the file start");
-    double gain = median(gains.size() >= 3 ? gains : allGains);
-    if (!(gain > 0)) gain = 1.0;
-    if (set.units == "N") {
-        if (std::abs(gain - 1.0) > 0.2)
-            d.warnings.push_back("calibrated in N, but the pre-slip ramps suggest a scale of " + std::to_string(gain) +
-                                 " units per N: the string data may be off");
-        gain = 1.0;
-    }
-    d.scale = 1.0 / gain;
-    // Second pass with the set's gain fixed: trigger, DC and hum of each stroke are then
-    // well determined even when its ramp is short.
-    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-        if (cal[i].firstSlip < 0) return;
-        Calibration again = calibrateRecording(recording(i, set.units == "N" ? 1.0 : gain));
-        if (again.rampFitted) cal[i] = std::move(again);
-        if (set.strokes[i].trigger) cal[i].trigger = *set.strokes[i].trigger;
-    });
-    std::vector<Prepared> strokes(n);
-    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-        const MeasuredStroke& s = set.strokes[i];
-        Prepared& p = strokes[i];
-        p.id = s.id;
-        p.a = s.accel;
-        p.F = s.force;
-        const auto from = static_cast<std::size_t>(std::max(0.0, cal[i].trigger) * set.sampleRate);
-        std::vector<double> f;
-        // Unfitted strokes are in signal units: the set's gain converts them.
-        const double toNewtons = cal[i].rampFitted ? cal[i].gain / gain : 1.0 / gain;
-        for (std::size_t k = from; k < cal[i].force.size(); ++k) f.push_back(cal[i].force[k] * toNewtons);
-        f = resample(f, set.sampleRate, o.simRate);
-        f.resize(std::min(f.size(), static_cast<std::size_t>(0.5 * o.simRate)));
-        p.force = std::move(f);
-        p.feat = features(p.force, o.simRate, p.a, p.F, info, true);
-    });
+    std::vector<Prepared> strokes = prepareStrokes(set, info, o, d);
+    const std::size_t n = strokes.size();
 
-    // 2. Fit and held-out strokes, drawn from the seed before anything is fitted.
+    // 2. Fit, validation and test strokes, drawn from the seed before anything is fitted.
     std::vector<std::size_t> order(n);
     std::iota(order.begin(), order.end(), 0);
     std::mt19937_64 rng(o.seed);
     std::shuffle(order.begin(), order.end(), rng);
-    const auto nFit = static_cast<std::size_t>(std::lround(o.fitFraction * static_cast<double>(n)));
-    if (nFit < 4 || n - nFit < 4) throw LabError(set.folder.string() + ": too few strokes to split into fit and held-out sets (need 8)");
-    std::vector<std::size_t> fitSet(order.begin(), order.begin() + static_cast<long>(nFit)), held(order.begin() + static_cast<long>(nFit), order.end());
-    std::sort(fitSet.begin(), fitSet.end());
-    std::sort(held.begin(), held.end());
+    const auto nTest = static_cast<std::size_t>(std::lround(o.testFraction * static_cast<double>(n)));
+    const auto nVal = static_cast<std::size_t>(std::lround(o.validationFraction * static_cast<double>(n)));
+    if (nTest < 4 || nVal < 4 || n - nTest - nVal < 6)
+        throw LabError(set.folder.string() + ": too few strokes to split into fit, validation and test sets (need 16)");
+    std::vector<std::size_t> testSet(order.begin(), order.begin() + static_cast<long>(nTest));
+    std::vector<std::size_t> valSet(order.begin() + static_cast<long>(nTest), order.begin() + static_cast<long>(nTest + nVal));
+    std::vector<std::size_t> fitSet(order.begin() + static_cast<long>(nTest + nVal), order.end());
+    for (auto* v : {&testSet, &valSet, &fitSet}) std::sort(v->begin(), v->end());
     for (auto i : fitSet) d.fitIds.push_back(strokes[i].id);
-    for (auto i : held) d.heldoutIds.push_back(strokes[i].id);
+    for (auto i : valSet) d.validationIds.push_back(strokes[i].id);
+    for (auto i : testSet) d.heldoutIds.push_back(strokes[i].id);
     d.nFit = fitSet.size();
-    d.nHeldout = held.size();
+    d.nValidation = valSet.size();
+    d.nHeldout = testSet.size();
 
-    // 3. From the baseline, add the extension that helps most on held-out strokes, if it
-    //    helps significantly; repeat.
-    Engine engine(strokes, info, o.simRate);
+    // 3. Calibration before causes: the rig's steady sliding, then tension and bow position.
+    std::optional<dsp::SteadyCurve> steady;
+    if (set.steady.size() >= 5) {
+        const SteadyFitResult sf = fitSteadySliding(set.steady);
+        steady = sf.curve;
+        d.calibration.push_back({"mu_static", "static friction of the rig's rosin, from steady_sliding.csv (SW00 shape, 4 factors)", sf.muStatic,
+                                 sf.muStatic - 1.96 * sf.muStaticSd, sf.muStatic + 1.96 * sf.muStaticSd});
+        if (sf.rms > 0.05)
+            d.warnings.push_back("steady_sliding.csv departs from the SW00 shape by " + std::to_string(100 * sf.rms) + " % rms");
+    } else {
+        d.warnings.push_back(set.steady.empty() ? "no steady_sliding.csv: the reference SW00 curve is assumed for this rosin"
+                                                : "steady_sliding.csv has fewer than 5 rows: the reference SW00 curve is assumed");
+    }
+    Engine engine(strokes, info, o.simRate, steady);
     EffectModel current;
+    if (o.fitNuisances) {
+        say("calibration: tension and bow position", 0.0);
+        Candidate cal{"calibration", {}, {"tension_scale", "beta_scale"}, {0.95, 0.96}, {1.05, 1.04}, {1.0, 1.0}};
+        const auto x = fit(engine, current, cal, fitSet, cal.start, o.maxEvaluations, 0.2);
+        current = apply(current, cal, x);
+    }
     d.baseline = current;
-    std::vector<ErrorParts> currentHeld = engine.errors(current, held);
-    d.baselineError = Engine::mean(currentHeld);
-    const std::vector<ErrorParts> baselineHeld = currentHeld;
+    const std::vector<ErrorParts> baselineTest = engine.errors(current, testSet);
+    std::vector<ErrorParts> currentVal = engine.errors(current, valSet), currentTest = baselineTest;
+    d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, tension within +-5 % and bow position within "
+               "+-4 % of the manifest, fitted on the fit strokes with the baseline model; effects are fitted on top of them.",
+               "An effect is fitted on the fit strokes and named only when (1) its validation-error fall is the largest of the round "
+               "with a 95 % paired-bootstrap interval above 0, (2) the fall is at least " + std::to_string(static_cast<int>(std::lround(100 * o.namingThreshold))) +
+                   " % of the validation error (threshold calibrated on null sets), (3) it also lowers the error of the test strokes, "
+                   "(4) the 95 % interval of its parameter (bootstrap refits) excludes the no-effect value (exponent 1, shift 0 K, "
+                   "Z_t/Z_0 >= 7.5, speed exponent <= 0.03), and (5) refitted on the low- and on the high-acceleration half of the fit "
+                   "strokes it keeps away from the no-effect value with consistent values.",
+               "The reported gain compares the calibrated baseline and the final model on the test strokes only."};
+
+    // 4. From the calibrated baseline, add effects one round at a time.
     int round = 0;
     while (true) {
         ++round;
-        const auto cands = candidates(current);
+        std::vector<Candidate> cands;
+        for (const Candidate& c : candidates(current)) cands.push_back(withNuisances(c, current));
         if (cands.empty()) break;
         struct Tried {
             Candidate c;
             std::vector<double> x;
-            std::vector<ErrorParts> held;
+            std::vector<ErrorParts> val;
             std::array<double, 3> gain;
+            std::size_t trial;
         };
         std::vector<Tried> tried;
+        const double valBefore = mean(currentVal);
         for (std::size_t k = 0; k < cands.size(); ++k) {
             say("round " + std::to_string(round) + ": " + cands[k].effect, static_cast<double>(k) / static_cast<double>(cands.size()));
             double fitError = 0;
-            Tried t{cands[k], fit(engine, current, cands[k], fitSet, cands[k].start, o.maxEvaluations, 0.2, &fitError), {}, {}};
-            t.held = engine.errors(apply(current, t.c, t.x), held);
-            t.gain = pairedGain(currentHeld, t.held, o.bootstrap, o.seed + static_cast<std::uint64_t>(round * 100 + static_cast<int>(k)));
+            Tried t{cands[k], fit(engine, current, cands[k], fitSet, cands[k].start, o.maxEvaluations, 0.2, &fitError), {}, {}, d.trials.size()};
+            t.val = engine.errors(apply(current, t.c, t.x), valSet);
+            t.gain = pairedGain(currentVal, t.val, o.bootstrap, o.seed + static_cast<std::uint64_t>(round * 100 + static_cast<int>(k)));
             Trial trial;
             trial.round = round;
             trial.effect = t.c.effect;
@@ -484,45 +341,81 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             trial.gain = t.gain[0];
             trial.gainLow = t.gain[1];
             trial.gainHigh = t.gain[2];
+            trial.relativeGain = valBefore > 0 ? t.gain[0] / valBefore : 0.0;
+            trial.verdict = "not the largest fall";
+            if (!(t.gain[1] > 0.0)) trial.verdict = "validation fall not significant";
+            else if (trial.relativeGain < o.namingThreshold) trial.verdict = "validation fall below the threshold";
             d.trials.push_back(trial);
             tried.push_back(std::move(t));
         }
-        const double base = Engine::mean(currentHeld);
+        std::sort(tried.begin(), tried.end(), [](const Tried& a, const Tried& b) { return a.gain[0] > b.gain[0]; });
         const Tried* best = nullptr;
-        for (const auto& t : tried) {
+        std::map<std::string, double> halfWidth;
+        for (const Tried& t : tried) {
+            Trial& trial = d.trials[t.trial];
+            if (!(t.gain[1] > 0.0) || trial.relativeGain < o.namingThreshold) continue;
             std::map<std::string, double> fitted;
             for (std::size_t j = 0; j < t.c.names.size(); ++j) fitted[t.c.names[j]] = t.x[j];
-            if (atNull(t.c.effect, fitted)) continue;
-            if (t.gain[1] > 0.0 && t.gain[0] >= o.minRelativeGain * base && (!best || t.gain[0] > best->gain[0])) best = &t;
+            if (atNull(t.c.effect, fitted)) { trial.verdict = "fitted at the effect's own absence"; continue; }
+            // (3) the test strokes
+            const EffectModel cand = apply(current, t.c, t.x);
+            trial.testGain = mean(currentTest) - mean(engine.errors(cand, testSet));
+            if (!(trial.testGain > 0.0)) { trial.verdict = "no gain on the test strokes"; continue; }
+            // (4) intervals from refits on bootstrap resamples, each from a fresh start
+            say("round " + std::to_string(round) + ": uncertainty of " + t.c.effect, 0.0);
+            std::vector<std::vector<double>> refits;
+            std::mt19937_64 prng(o.seed * 31ull + static_cast<std::uint64_t>(round));
+            std::uniform_int_distribution<std::size_t> pick(0, fitSet.size() - 1);
+            std::uniform_real_distribution<double> jump(-0.15, 0.15);
+            for (int b = 0; b < o.parameterBootstrap; ++b) {
+                std::vector<std::size_t> resampled;
+                for (std::size_t k = 0; k < fitSet.size(); ++k) resampled.push_back(fitSet[pick(prng)]);
+                std::vector<double> start = t.x;
+                for (std::size_t k = 0; k < start.size(); ++k)
+                    start[k] = std::clamp(start[k] + jump(prng) * (t.c.hi[k] - t.c.lo[k]), t.c.lo[k], t.c.hi[k]);
+                refits.push_back(fit(engine, current, t.c, resampled, start, std::max(8, o.maxEvaluations / 2), 0.1, nullptr, false));
+            }
+            halfWidth.clear();
+            bool atNullInterval = false;
+            for (std::size_t k = 0; k < t.c.names.size(); ++k) {
+                double m = 0, v = 0;
+                for (const auto& r : refits) m += r[k];
+                m /= static_cast<double>(refits.size());
+                for (const auto& r : refits) v += (r[k] - m) * (r[k] - m);
+                const double hw = refits.size() > 1 ? 1.96 * std::sqrt(v / static_cast<double>(refits.size() - 1)) : 0.0;
+                halfWidth[t.c.names[k]] = hw;
+                atNullInterval = atNullInterval || intervalAtNull(t.c.names[k], t.x[k] - hw, t.x[k] + hw);
+            }
+            if (atNullInterval) { trial.verdict = "interval reaches the no-effect value"; continue; }
+            // (5) the two force halves of the fit strokes
+            bool halvesAgree = true;
+            std::vector<std::vector<double>> halves;
+            for (bool high : {false, true})
+                halves.push_back(fit(engine, current, t.c, subset(fitSet, strokes, high), t.x, std::max(8, o.maxEvaluations / 2), 0.1, nullptr, false));
+            std::map<std::string, double> lowFit, highFit;
+            for (std::size_t k = 0; k < t.c.names.size(); ++k) {
+                lowFit[t.c.names[k]] = halves[0][k];
+                highFit[t.c.names[k]] = halves[1][k];
+                const double spread = std::abs(halves[0][k] - halves[1][k]);
+                if (spread > 2.0 * halfWidth[t.c.names[k]] + 0.1 * (t.c.hi[k] - t.c.lo[k])) halvesAgree = false;
+            }
+            if (atNull(t.c.effect, lowFit) || atNull(t.c.effect, highFit) || !halvesAgree) {
+                trial.verdict = "not consistent on the two acceleration halves";
+                continue;
+            }
+            trial.verdict = "named";
+            best = &t;
+            break;
         }
         if (!best) break;
-        for (auto& trial : d.trials)
-            if (trial.round == round && trial.effect == best->c.effect) trial.kept = true;
-        // Parameter uncertainty: refits on bootstrap resamples of the fit strokes.
-        std::vector<std::vector<double>> refits;
-        std::mt19937_64 prng(o.seed * 31ull + static_cast<std::uint64_t>(round));
-        std::uniform_int_distribution<std::size_t> pick(0, fitSet.size() - 1);
-        for (int b = 0; b < o.parameterBootstrap; ++b) {
-            say("round " + std::to_string(round) + ": uncertainty of " + best->c.effect, static_cast<double>(b) / o.parameterBootstrap);
-            std::vector<std::size_t> resample_;
-            for (std::size_t k = 0; k < fitSet.size(); ++k) resample_.push_back(fitSet[pick(prng)]);
-            refits.push_back(fit(engine, current, best->c, resample_, best->x, std::max(8, o.maxEvaluations / 2), 0.05, nullptr, false));
-        }
-        std::map<std::string, double> halfWidth;
-        for (std::size_t k = 0; k < best->c.names.size(); ++k) {
-            double mean = 0, var = 0;
-            for (const auto& r : refits) mean += r[k];
-            mean /= static_cast<double>(std::max<std::size_t>(1, refits.size()));
-            for (const auto& r : refits) var += (r[k] - mean) * (r[k] - mean);
-            halfWidth[best->c.names[k]] = refits.size() > 1 ? 1.96 * std::sqrt(var / static_cast<double>(refits.size() - 1)) : 0.0;
-        }
-        const double before = Engine::mean(currentHeld);
-        const std::vector<ErrorParts> stepBefore = currentHeld;
+        d.trials[best->trial].kept = true;
+        const double before = mean(currentVal);
+        const std::vector<ErrorParts> stepBefore = currentVal;
         const EffectModel from = current;
         current = apply(current, best->c, best->x);
-        currentHeld = best->held;
-        // A parameter fitted before a later effect entered the model may have stood in for it:
-        // refit all parameters together, and keep the refit if it does not do worse held out.
+        currentVal = best->val;
+        // A parameter fitted before a later effect entered may have stood in for it: refit all
+        // parameters, nuisances included, and keep the refit unless it does worse on validation.
         if (current.params.size() > 1) {
             say("round " + std::to_string(round) + ": joint refit", 0.0);
             Candidate all;
@@ -535,19 +428,18 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             }
             const auto x = fit(engine, current, all, fitSet, all.start, o.maxEvaluations, 0.05, nullptr, false);
             const EffectModel refit = apply(current, all, x);
-            const auto refitHeld = engine.errors(refit, held);
-            if (Engine::mean(refitHeld) <= Engine::mean(currentHeld)) {
-                current = refit;
-                currentHeld = refitHeld;
+            const auto refitVal = engine.errors(refit, valSet);
+            if (mean(refitVal) <= mean(currentVal)) {
                 for (auto& f : d.findings)
                     for (auto& [name, v] : f.parameters) {
-                        const double shift = current.params[name] - v[0];
-                        for (double& x2 : v) x2 += shift; // same width, centred on the joint value
+                        const double shift = refit.params.at(name) - v[0];
+                        for (double& x2 : v) x2 += shift;
                     }
+                current = refit;
+                currentVal = refitVal;
             }
         }
-        // One finding per effect the step switched on (a rate dependence or a rosin shift on top of
-        // a friction curve brings thermal memory with it).
+        currentTest = engine.errors(current, testSet);
         for (const auto& effect : best->c.adds) {
             if (has(from.effects, effect)) continue;
             Finding finding;
@@ -558,17 +450,54 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                     finding.parameters[name] = {v, v - halfWidth[name], v + halfWidth[name]};
                 }
             finding.heldoutBefore = before;
-            finding.heldoutAfter = Engine::mean(currentHeld);
-            finding.evidence = describe(effect, stepBefore, currentHeld, held, from, before, finding.heldoutAfter);
+            finding.heldoutAfter = mean(currentVal);
+            finding.evidence = describe(effect, stepBefore, currentVal, valSet, from, before, finding.heldoutAfter);
             d.findings.push_back(std::move(finding));
         }
     }
     d.final = current;
-    d.finalError = Engine::mean(currentHeld);
-    const auto g = pairedGain(baselineHeld, currentHeld, o.bootstrap, o.seed + 999);
+    // Calibration intervals and the findings' second interval, from the local curvature.
+    {
+        std::vector<std::string> names;
+        for (const auto& [name, value] : current.params) names.push_back(name);
+        if (!names.empty()) {
+            say("curvature intervals", 0.0);
+            Eigen::VectorXd x(static_cast<Eigen::Index>(names.size())), steps(x.size());
+            for (std::size_t k = 0; k < names.size(); ++k) {
+                x[static_cast<Eigen::Index>(k)] = current.params.at(names[k]);
+                const auto [lo, hi] = parameterBounds().at(names[k]);
+                steps[static_cast<Eigen::Index>(k)] = 0.03 * (hi - lo);
+            }
+            auto residuals = [&](const Eigen::VectorXd& y) {
+                EffectModel m = current;
+                for (std::size_t k = 0; k < names.size(); ++k) m.params[names[k]] = y[static_cast<Eigen::Index>(k)];
+                const auto e = engine.errors(m, fitSet);
+                Eigen::VectorXd r(static_cast<Eigen::Index>(e.size()));
+                for (std::size_t i = 0; i < e.size(); ++i) r[static_cast<Eigen::Index>(i)] = e[i].total();
+                return r;
+            };
+            const Eigen::MatrixXd cov = curvatureCovariance(residuals, x, steps);
+            for (std::size_t k = 0; k < names.size(); ++k) {
+                const auto kk = static_cast<Eigen::Index>(k);
+                const double v = x[kk], hw = 1.96 * std::sqrt(std::max(0.0, cov(kk, kk)));
+                if (isNuisance(names[k]))
+                    d.calibration.push_back({names[k], names[k] == "tension_scale" ? "true tension / manifest tension" : "true bow position / manifest beta", v,
+                                             v - hw, v + hw});
+                for (auto& f : d.findings)
+                    if (f.parameters.count(names[k])) f.curvature[names[k]] = {v - hw, v + hw};
+            }
+        }
+    }
+    d.baselineError = mean(baselineTest);
+    d.finalError = mean(currentTest);
+    const auto g = pairedGain(baselineTest, currentTest, o.bootstrap, o.seed + 999);
     d.relativeGain = d.baselineError > 0 ? g[0] / d.baselineError : 0.0;
     d.gainLow = d.baselineError > 0 ? g[1] / d.baselineError : 0.0;
     d.gainHigh = d.baselineError > 0 ? g[2] / d.baselineError : 0.0;
+
+    // 5. The set's own floor, and what the final model leaves above it.
+    say("noise and chaos floor", 0.0);
+    d.residual = measureResidual(engine, current, testSet, currentTest, strokes, o);
 
     // 4. What the report shows: every stroke under the baseline and the final model.
     say("report", 0.0);
@@ -628,16 +557,12 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             lc.measuredF.assign(m.friction.end() - static_cast<long>(3 * P), m.friction.end());
             lc.measuredArea = loopArea(lc.measuredV, lc.measuredF, 0, lc.measuredV.size());
         }
-        dsp::BowedStringConfig cfg = modelWithEffects(d.final.effects, d.final.params);
-        cfg.string.length = info.length;
-        cfg.string.tension = info.tension;
-        cfg.string.massPerLength = info.tension / std::pow(2.0 * info.length * info.f0, 2.0);
         dsp::BowedString<double> sim;
-        sim.prepare(o.simRate, cfg);
+        sim.prepare(o.simRate, engine.config(d.final));
         std::vector<double> b(rec.bridge.size() * static_cast<std::size_t>(o.simRate) / static_cast<std::size_t>(set.sampleRate)), f(b.size());
         for (std::size_t i = 0; i < b.size(); ++i) {
             const double t = static_cast<double>(i) / o.simRate;
-            b[i] = sim.processSample(rec.force, rec.bowSpeed * std::min(1.0, t / 0.03), info.beta);
+            b[i] = sim.processSample(rec.force, rec.bowSpeed * std::min(1.0, t / 0.03), engine.beta(d.final));
             f[i] = sim.waveguide().farEndForce();
         }
         zeroPhaseLowPass(b, kCompareCutoff, o.simRate);

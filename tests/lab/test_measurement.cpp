@@ -274,7 +274,7 @@ TEST(DiagnoseCli, WritesTheDiagnosisAndRefusesABrokenSetWritingNothing)
     std::ifstream in(d / "out" / "diagnosis.json");
     const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     for (const char* key : {"\"format\": \"rosin-diagnosis/1\"", "\"baseline_model\": \"friction_curve\"", "\"findings\"",
-                            "\"final_model\"", "\"gain\"", "\"ci95\"", "\"n_fit\": 11", "\"n_heldout\": 5", "\"calibration\"",
+                            "\"final_model\"", "\"gain\"", "\"ci95\"", "\"n_fit\": 8", "\"n_validation\": 4", "\"n_heldout\": 4", "\"unexplained_residual\"", "\"calibration\"",
                             "\"scale_n_per_unit\"", "\"warnings\""})
         EXPECT_NE(json.find(key), std::string::npos) << key;
     // A broken set: refused, naming the file and field, and no output folder appears.

@@ -43,6 +43,9 @@ struct DiagnoseCommand {
         diagnoseCmd->add_option("--seed", diagOptions.seed, "Seed of the fit/held-out split and the bootstraps")->capture_default_str();
         diagnoseCmd->add_option("--sim-rate", diagOptions.simRate, "Simulation rate (Hz)")->check(finiteIn(16000, 400000))->capture_default_str();
         diagnoseCmd->add_option("--max-evaluations", diagOptions.maxEvaluations, "Model evaluations per candidate fit")->check(CLI::Range(5, 500))->capture_default_str();
+        diagnoseCmd->add_option("--naming-threshold", diagOptions.namingThreshold, "Least validation-error fall (share) of a named effect")->check(finiteIn(0, 1))->capture_default_str();
+        diagnoseCmd->add_option("--residual-factor", diagOptions.residualFactor, "Final error above this many floors: unexplained residual")->check(finiteIn(1, 100))->capture_default_str();
+        diagnoseCmd->add_flag("!--no-nuisances", diagOptions.fitNuisances, "Do not fit tension and bow position as calibration");
         diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
         return diagnoseCmd;
     }
@@ -72,15 +75,19 @@ struct DiagnoseCommand {
             for (const auto& t : dg.trials) {
                 std::printf("round %d: %-24s", t.round, t.effect.c_str());
                 for (const auto& [k, v] : t.parameters) std::printf(" %s=%.3g", k.c_str(), v);
-                std::printf("  held-out fall %.3f [%.3f, %.3f]%s\n", t.gain, t.gainLow, t.gainHigh, t.kept ? "  kept" : "");
+                std::printf("  validation fall %.3f [%.3f, %.3f]: %s\n", t.gain, t.gainLow, t.gainHigh, t.verdict.c_str());
             }
-            if (dg.findings.empty()) std::printf("finding: none (the baseline explains the data)\n");
+            for (const auto& c : dg.calibration) std::printf("calibration: %s = %.4g [%.4g, %.4g]\n", c.name.c_str(), c.value, c.low, c.high);
+            if (dg.findings.empty())
+                std::printf(dg.residual.present ? "finding: none named, but an unexplained residual (%.1f x the floor)\n"
+                                                : "finding: none (the calibrated baseline is within %.1f x the floor)\n", dg.residual.ratio);
+            if (dg.residual.present) std::printf("unexplained residual at %s: %s\n", dg.residual.where.c_str(), dg.residual.looksLike.c_str());
             for (const auto& f : dg.findings) {
                 std::printf("finding: %s", f.effect.c_str());
                 for (const auto& [name, v] : f.parameters) std::printf("  %s = %.3g [%.3g, %.3g]", name.c_str(), v[0], v[1], v[2]);
                 std::printf("\n  %s\n", f.evidence.c_str());
             }
-            std::printf("held-out error %.3f -> %.3f (gain %.0f %%, CI %.0f..%.0f %%); %lld simulations in %.1f s; wrote %s/\n",
+            std::printf("test error %.3f -> %.3f (gain %.0f %%, CI %.0f..%.0f %%); %lld simulations in %.1f s; wrote %s/\n",
                         dg.baselineError, dg.finalError, 100 * dg.relativeGain, 100 * dg.gainLow, 100 * dg.gainHigh,
                         dg.simulations, dg.seconds, diagOut.c_str());
         }

@@ -21,6 +21,7 @@ struct ClassifierSettings {
     double periodTolerance = 0.10;  ///< H spacing within +-10 % of the period
     double sMotionRipple = 0.30;    ///< ripple / flyback above which an H period is S-motion
     double slipFloor = 1e-9;        ///< a first slip must drop the force by at least this (N)
+    double minSlipForce = 0.0;      ///< a first slip comes only after the force has reached this (N)
 };
 
 struct ClassifierInput {
@@ -38,6 +39,9 @@ struct ClassifierInput {
     /// Recording mode: signal units per newton when already known (e.g. one gain for a whole
     /// set); then only trigger, DC and hum are fitted. 0 = unknown, fitted per recording.
     double knownGain = 0.0;
+    /// Mains hum to take out of a recording: -1 = decide from this recording (BIC between no
+    /// hum, 50 Hz and 60 Hz), 0 = none, 50 or 60 = that frequency and its harmonics.
+    double hum = -1.0;
 };
 
 /// Input for a constant-acceleration (Guettler) stroke, v_b = accel * t.

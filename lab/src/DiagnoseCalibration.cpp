@@ -1,0 +1,195 @@
+// Calibration pieces of the diagnosis: covariances from the local curvature (Eigen) and the
+// rig's steady-sliding curve fitted to its steady_sliding.csv.
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "DiagnoseEngine.h"
+#include "rosin/lab/Classifier.h"
+#include "rosin/lab/Error.h"
+#include "rosin/lab/Resample.h"
+
+namespace rosin::lab::diag {
+
+/// Covariance of x by the local curvature: residuals r(x) (one per stroke), Jacobian by central
+/// differences with the given steps, s^2 (J^T J)^-1 with s^2 = |r|^2 / (n - p).
+Eigen::MatrixXd curvatureCovariance(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& residuals, const Eigen::VectorXd& x,
+                                    const Eigen::VectorXd& steps)
+{
+    const Eigen::VectorXd r0 = residuals(x);
+    const auto n = r0.size(), p = x.size();
+    Eigen::MatrixXd J(n, p);
+    for (Eigen::Index k = 0; k < p; ++k) {
+        Eigen::VectorXd up = x, down = x;
+        up[k] += steps[k];
+        down[k] -= steps[k];
+        J.col(k) = (residuals(up) - residuals(down)) / (2.0 * steps[k]);
+    }
+    const double s2 = r0.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, n - p));
+    const Eigen::MatrixXd JtJ = J.transpose() * J;
+    // A direction the data do not constrain has no curvature: its variance is unbounded.
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(p, p, 0.0);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(JtJ);
+    const double top = eig.eigenvalues().maxCoeff();
+    for (Eigen::Index k = 0; k < p; ++k) {
+        const double l = eig.eigenvalues()[k];
+        const Eigen::VectorXd v = eig.eigenvectors().col(k);
+        cov += (l > 1e-10 * top && l > 0 ? s2 / l : 1e12) * v * v.transpose();
+    }
+    return cov;
+}
+
+SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts)
+{
+    auto curve = [](const Eigen::VectorXd& q) {
+        return dsp::SteadyCurve::exponentials(0.4 * q[0], 0.01 * q[1], 0.45 * q[0], 0.1 * q[2], 0.35 * q[0] * q[3]);
+    };
+    auto residuals = [&](const Eigen::VectorXd& q) {
+        const dsp::SteadyCurve c = curve(q);
+        Eigen::VectorXd r(static_cast<Eigen::Index>(pts.size()));
+        for (std::size_t i = 0; i < pts.size(); ++i) r[static_cast<Eigen::Index>(i)] = c(pts[i].speed).mu / pts[i].mu - 1.0;
+        return r;
+    };
+    Eigen::VectorXd q = Eigen::VectorXd::Ones(4);
+    const Eigen::VectorXd steps = Eigen::VectorXd::Constant(4, 1e-5);
+    double lambda = 1e-3;
+    for (int it = 0; it < 100; ++it) {
+        const Eigen::VectorXd r = residuals(q);
+        Eigen::MatrixXd J(r.size(), 4);
+        for (int k = 0; k < 4; ++k) {
+            Eigen::VectorXd up = q;
+            up[k] += steps[k];
+            J.col(k) = (residuals(up) - r) / steps[k];
+        }
+        Eigen::MatrixXd A = J.transpose() * J;
+        A.diagonal() *= 1.0 + lambda;
+        Eigen::VectorXd next = q - A.ldlt().solve(J.transpose() * r);
+        next[1] = std::clamp(next[1], 0.2, 5.0);
+        next[2] = std::clamp(next[2], 0.2, 5.0);
+        next[3] = std::clamp(next[3], 0.2, 3.0);
+        next[0] = std::clamp(next[0], 0.2, 3.0);
+        if (residuals(next).squaredNorm() < r.squaredNorm()) {
+            const bool done = (next - q).norm() < 1e-10;
+            q = next;
+            lambda *= 0.3;
+            if (done) break;
+        } else {
+            lambda *= 10.0;
+        }
+    }
+    SteadyFitResult out;
+    out.curve = curve(q);
+    out.muStatic = out.curve(0.0).mu;
+    out.rms = std::sqrt(residuals(q).squaredNorm() / static_cast<double>(pts.size()));
+    const Eigen::MatrixXd cov = curvatureCovariance(residuals, q, Eigen::VectorXd::Constant(4, 1e-4));
+    // mu(0) = q0 (0.4 + 0.45 + 0.35 q3)
+    Eigen::VectorXd g(4);
+    g << 0.85 + 0.35 * q[3], 0.0, 0.0, 0.35 * q[0];
+    out.muStaticSd = std::sqrt(std::max(0.0, static_cast<double>(g.transpose() * cov * g)));
+    return out;
+}
+
+/// One of two disjoint halves of the fit strokes: below or above their median bow acceleration.
+/// (Halves by force would take away the lever arm a load exponent is measured on.)
+
+std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo& info, const DiagnoseOptions& o, Diagnosis& d)
+{
+    // 1. Clean every recording and find its gesture start; one gain for the whole set.
+    const std::size_t n = set.strokes.size();
+    std::vector<Calibration> cal(n);
+    // knownGain 0: gain fitted per recording.
+    auto recording = [&](std::size_t i, double knownGain) {
+        const MeasuredStroke& s = set.strokes[i];
+        ClassifierInput in = guettlerStrokeInput(s.signal, set.sampleRate, info.f0, info.beta, info.z0, info.tension, info.length, s.accel);
+        in.measured = true;
+        in.knownGain = knownGain;
+        return in;
+    };
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+        cal[i] = calibrateRecording(recording(i, 0.0));
+        if (set.strokes[i].trigger) cal[i].trigger = *set.strokes[i].trigger;
+    });
+    std::vector<double> gains, allGains;
+    int unfitted = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (cal[i].firstSlip < 0) continue;
+        if (!cal[i].rampFitted) {
+            ++unfitted;
+            continue;
+        }
+        allGains.push_back(cal[i].gain);
+        // The ramp gives the gain only once the string is quasi-statically deflected.
+        if (cal[i].firstSlip / set.sampleRate - cal[i].trigger > 4.0 / info.f0) gains.push_back(cal[i].gain);
+    }
+    // The gesture starts were estimated, not taken as the file starts, when any ramp fitted.
+    d.triggersDetected = !allGains.empty();
+    if (unfitted > 0)
+        d.warnings.push_back(std::to_string(unfitted) + " stroke(s) slipped before a pre-slip ramp could be fitted: their gesture start is taken as the file start");
+    double gain = median(gains.size() >= 3 ? gains : allGains);
+    if (!(gain > 0)) gain = 1.0;
+    if (set.units == "N") {
+        if (std::abs(gain - 1.0) > 0.2)
+            d.warnings.push_back("calibrated in N, but the pre-slip ramps suggest a scale of " + std::to_string(gain) +
+                                 " units per N: the string data may be off");
+        gain = 1.0;
+    }
+    d.scale = 1.0 / gain;
+    // Mains hum: taken out of every recording only when most recordings show it.
+    double setHum = 0.0;
+    {
+        int n50 = 0, n60 = 0, fitted = 0;
+        for (std::size_t i = 0; i < n; ++i)
+            if (cal[i].rampFitted) {
+                ++fitted;
+                n50 += cal[i].hum == 50.0;
+                n60 += cal[i].hum == 60.0;
+            }
+        if (fitted > 0 && std::max(n50, n60) * 2 > fitted) setHum = n50 >= n60 ? 50.0 : 60.0;
+    }
+    // Second pass with the set's gain fixed: trigger, DC and hum of each stroke are then
+    // well determined even when its ramp is short.
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+        if (cal[i].firstSlip < 0) return;
+        ClassifierInput in = recording(i, set.units == "N" ? 1.0 : gain);
+        in.hum = setHum;
+        Calibration again = calibrateRecording(in);
+        if (again.rampFitted) cal[i] = std::move(again);
+        if (set.strokes[i].trigger) cal[i].trigger = *set.strokes[i].trigger;
+    });
+    std::vector<Prepared> strokes(n);
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+        const MeasuredStroke& s = set.strokes[i];
+        Prepared& p = strokes[i];
+        p.id = s.id;
+        p.a = s.accel;
+        p.F = s.force;
+        const auto from = static_cast<std::size_t>(std::max(0.0, cal[i].trigger) * set.sampleRate);
+        std::vector<double> f;
+        // Unfitted strokes are in signal units: the set's gain converts them.
+        const double toNewtons = cal[i].rampFitted ? cal[i].gain / gain : 1.0 / gain;
+        for (std::size_t k = from; k < cal[i].force.size(); ++k) f.push_back(cal[i].force[k] * toNewtons);
+        f = resample(f, set.sampleRate, o.simRate);
+        f.resize(std::min(f.size(), static_cast<std::size_t>(0.5 * o.simRate)));
+        p.force = std::move(f);
+        p.noise = noiseLevel(p.force);
+        p.feat = features(p.force, o.simRate, p.a, p.F, info, true);
+    });
+
+
+    d.calibration.push_back({"scale_n_per_unit", "sensor scale (N per signal unit) from the pre-slip ramps", d.scale, d.scale, d.scale});
+    {
+        std::vector<double> dcs;
+        for (const auto& c : cal) dcs.push_back(c.dc * d.scale);
+        const double dc = median(dcs);
+        d.calibration.push_back({"dc_n", "sensor offset taken out (median over strokes, N)", dc, dc, dc});
+        d.calibration.push_back({"hum_hz", setHum > 0 ? "mains hum taken out (with 3 harmonics): most recordings show it"
+                                                      : "no mains hum taken out: most recordings do not show it",
+                                 setHum, setHum, setHum});
+    }
+    return strokes;
+}
+
+} // namespace rosin::lab::diag

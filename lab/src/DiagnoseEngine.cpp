@@ -1,0 +1,134 @@
+#include "DiagnoseEngine.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "rosin/lab/Classifier.h"
+#include "rosin/lab/Resample.h"
+#include "rosin/lab/SynthData.h"
+
+namespace rosin::lab::diag {
+
+double noiseLevel(const std::vector<double>& f)
+{
+    // Second differences: a ramp or a slow sawtooth leaves nothing, white noise of rms s leaves
+    // rms s sqrt(6); the median keeps the flybacks out.
+    if (f.size() < 4) return 0.0;
+    std::vector<double> d(f.size() - 2);
+    for (std::size_t i = 1; i + 1 < f.size(); ++i) d[i - 1] = std::abs(f[i + 1] - 2.0 * f[i] + f[i - 1]);
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
+}
+
+StrokeFeatures features(std::vector<double> f, double fs, double a, double F, const StringInfo& s, bool recorded)
+{
+    zeroPhaseLowPass(f, kCompareCutoff, fs);
+    const ClassifierInput in = guettlerStrokeInput(f, fs, s.f0, s.beta, s.z0, s.tension, s.length, a);
+    ClassifierSettings st;
+    // A first slip drops the force by more than 2 % of the bow force, and in a recording by
+    // clearly more than its noise can within 0.1 ms.
+    st.slipFloor = std::max(0.02 * F, recorded ? 6.0 * noiseLevel(f) : 0.0);
+    // No rosin lets go before the bridge force has reached a quarter of the bow force: an
+    // earlier drop is noise or a badly found gesture start, in a recording and a model alike.
+    st.minSlipForce = 0.25 * F;
+    const Classification c = classify(in, st);
+    StrokeFeatures r;
+    r.firstSlip = c.firstSlipTime;
+    r.forceBeforeSlip = c.forceBeforeSlip;
+    r.firstDrop = c.firstDrop;
+    r.transientPeriods = c.transientPeriods;
+    r.regime = c.regime;
+    if (c.firstSlipTime > 0) {
+        const auto start = static_cast<std::size_t>(c.firstSlipTime * fs);
+        const auto len = static_cast<std::size_t>(2.0 * fs / s.f0);
+        for (std::size_t i = start; i < start + len && i < f.size(); ++i) r.wave.push_back(f[i]);
+    }
+    return r;
+}
+
+ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, double a, double F, const StringInfo& info)
+{
+    ErrorParts e;
+    if (m.firstSlip < 0 && s.firstSlip < 0) return e;
+    if (m.firstSlip < 0 || s.firstSlip < 0) return {1, 1, 1, 1, 1};
+    e.firstSlip = std::min(1.0, std::abs(s.firstSlip - m.firstSlip) / m.firstSlip);
+    e.forceBeforeSlip = std::min(1.0, std::abs(s.forceBeforeSlip - m.forceBeforeSlip) / F);
+    e.jump = std::min(1.0, std::abs(s.firstDrop - m.firstDrop) / F);
+    const double nm = m.transientPeriods < 0 ? 30 : m.transientPeriods, ns = s.transientPeriods < 0 ? 30 : s.transientPeriods;
+    e.transient = std::min(1.0, std::abs(nm - ns) / 25.0);
+    const std::size_t n = std::min(m.wave.size(), s.wave.size());
+    if (n > 0) {
+        double acc = 0;
+        for (std::size_t i = 0; i < n; ++i) acc += (m.wave[i] - s.wave[i]) * (m.wave[i] - s.wave[i]);
+        const double flyback = 2.0 * info.z0 * a * m.firstSlip / info.beta;
+        e.waveform = std::min(1.0, std::sqrt(acc / static_cast<double>(n)) / std::max(flyback, 1e-9));
+    }
+    return e;
+}
+
+double mean(const std::vector<ErrorParts>& e)
+{
+    double s = 0;
+    for (const auto& x : e) s += x.total();
+    return e.empty() ? 0.0 : s / static_cast<double>(e.size());
+}
+
+dsp::BowedStringConfig Engine::config(const EffectModel& m) const
+{
+    auto get = [&](const char* k) { return m.params.count(k) ? m.params.at(k) : 1.0; };
+    dsp::BowedStringConfig c = modelWithEffects(m.effects, m.params);
+    c.friction.steadyCurve = steady_;
+    // The string is tuned to the manifest's pitch: a tension off by s moves its mass with it.
+    c.string.length = info_.length;
+    c.string.tension = info_.tension * get("tension_scale");
+    c.string.massPerLength = c.string.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
+    return c;
+}
+
+double Engine::beta(const EffectModel& m) const
+{
+    return info_.beta * (m.params.count("beta_scale") ? m.params.at("beta_scale") : 1.0);
+}
+
+StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector<double>* head, double jitterF, double jitterA,
+                                std::uint64_t noiseSeed) const
+{
+    // One prepared voice per thread, kept while the model stays the same (all the strokes of
+    // one evaluation): reset() restores it exactly, prepare() would rebuild its tables.
+    Voice& v = voices_.local();
+    if (!v.string || v.model.effects != m.effects || v.model.params != m.params) {
+        if (!v.string) v.string = std::make_unique<dsp::BowedString<double>>();
+        v.string->prepare(fs_, config(m));
+        v.model = m;
+    } else {
+        v.string->reset();
+    }
+    dsp::BowedString<double>& s = *v.string;
+    const Prepared& p = strokes_[i];
+    const double F = p.F * (1.0 + jitterF), a = p.a * (1.0 + jitterA), b = beta(m);
+    std::vector<double> out(p.force.size());
+    for (std::size_t n = 0; n < out.size(); ++n) out[n] = s.processSample(F, a * static_cast<double>(n) / fs_, b);
+    ++simulations_;
+    if (head) head->assign(out.begin(), out.begin() + static_cast<long>(std::min(out.size(), static_cast<std::size_t>(12.0 * fs_ / info_.f0 + 0.02 * fs_))));
+    if (p.noise > 0.0) {
+        std::mt19937_64 rng(0x9e3779b97f4a7c15ull * (i + 1) + noiseSeed);
+        std::normal_distribution<double> g(0.0, p.noise);
+        for (double& x : out) x += g(rng);
+    }
+    return features(std::move(out), fs_, p.a, p.F, info_, true);
+}
+
+std::vector<ErrorParts> Engine::errors(const EffectModel& m, const std::vector<std::size_t>& which) const
+{
+    std::vector<ErrorParts> e(which.size());
+    tbb::parallel_for(std::size_t(0), which.size(), [&](std::size_t k) {
+        const std::size_t i = which[k];
+        e[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].a, strokes_[i].F, info_);
+    });
+    return e;
+}
+
+} // namespace rosin::lab::diag

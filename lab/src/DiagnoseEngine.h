@@ -1,0 +1,111 @@
+// The diagnosis's simulation engine (internal to lab/): measured and simulated stroke features,
+// their per-stroke disagreement, and a cache of prepared voices per thread.
+#pragma once
+#include <Eigen/Core>
+#include <tbb/enumerable_thread_specific.h>
+
+#include <algorithm>
+#include <atomic>
+#include <functional>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rosin/dsp.h"
+#include "rosin/lab/Diagnose.h"
+#include "rosin/lab/Measurement.h"
+
+namespace rosin::lab::diag {
+
+struct StringInfo {
+    double f0, beta, z0, tension, length;
+};
+
+struct Prepared {
+    std::string id;
+    double a = 0, F = 0;
+    std::vector<double> force; ///< N at the diagnosis rate, t = 0 at the gesture start
+    double noise = 0;          ///< rms noise of the recording (N), added to its simulations
+    StrokeFeatures feat;
+};
+
+constexpr double kCompareCutoff = 5000.0; // both signals see the same low-pass before comparison
+
+/// Noise of a low-passed recording: the robust spread of its sample-to-sample steps.
+double noiseLevel(const std::vector<double>& f);
+StrokeFeatures features(std::vector<double> f, double fs, double a, double F, const StringInfo& s, bool recorded = false);
+ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, double a, double F, const StringInfo& info);
+double mean(const std::vector<ErrorParts>& e);
+inline double median(std::vector<double> v)
+{
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
+/// A finding's evidence in plain words: which part of the comparison the extension mended most.
+std::string describe(const std::string& effect, const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after,
+                     const std::vector<std::size_t>& ids, const EffectModel& from, double errBefore, double errAfter);
+
+/// Step 1 of a diagnosis: every recording low-passed, cleaned (DC always; mains hum where most
+/// recordings show it), its gesture start found from the pre-slip ramp, one scale for the set;
+/// what was taken out goes into d.calibration, what had to be assumed into d.warnings.
+std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo& info, const DiagnoseOptions& o, Diagnosis& d);
+
+/// What a lab never knows exactly and diagnosis fits as calibration, not as a finding.
+inline bool isNuisance(const std::string& p) { return p == "tension_scale" || p == "beta_scale"; }
+
+/// Covariance of x by the local curvature: residuals r(x), Jacobian by central differences with
+/// the given steps, s^2 (J^T J)^-1 with s^2 = |r|^2 / (n - p); unconstrained directions get a
+/// huge variance instead of a made-up one.
+Eigen::MatrixXd curvatureCovariance(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& residuals, const Eigen::VectorXd& x,
+                                    const Eigen::VectorXd& steps);
+
+/// The rig's steady-sliding curve from its steady_sliding.csv: the SW00 shape with four factors
+/// (level, the two speed scales, the high-speed floor) by Levenberg-Marquardt on relative residuals.
+struct SteadyFitResult {
+    dsp::SteadyCurve curve;
+    double muStatic = 0, muStaticSd = 0, rms = 0;
+};
+SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts);
+
+class Engine {
+public:
+    Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady)
+        : strokes_(strokes), info_(info), fs_(fs), steady_(steady) {}
+
+    /// The voice of model m: its effects, the set's steady-sliding curve and the nuisances.
+    dsp::BowedStringConfig config(const EffectModel& m) const;
+    double beta(const EffectModel& m) const;
+    /// Simulated features of stroke i under model m as the rig would record them: the
+    /// recording's own noise level is added (from a fixed seed per stroke, so a fit sees a
+    /// smooth objective) and the first slip is found as in a recording. Force and acceleration
+    /// are scaled by (1 + jitterF), (1 + jitterA) for the floor's re-runs, which also take
+    /// another noise seed; optionally the first 12 periods (without noise).
+    StrokeFeatures simulate(const EffectModel& m, std::size_t i, std::vector<double>* head = nullptr, double jitterF = 0.0,
+                            double jitterA = 0.0, std::uint64_t noiseSeed = 0) const;
+    std::vector<ErrorParts> errors(const EffectModel& m, const std::vector<std::size_t>& which) const;
+    long long simulations() const { return simulations_.load(); }
+    const StringInfo& info() const { return info_; }
+
+private:
+    struct Voice {
+        EffectModel model;
+        std::unique_ptr<dsp::BowedString<double>> string;
+    };
+    std::vector<Prepared>& strokes_;
+    StringInfo info_;
+    double fs_;
+    std::optional<dsp::SteadyCurve> steady_;
+    mutable std::atomic<long long> simulations_{0};
+    mutable tbb::enumerable_thread_specific<Voice> voices_;
+};
+
+/// The floor of the test strokes (the final model against itself under the rig's scatter and
+/// noise) and what the final model leaves above it: which parts, where, and what it looks like.
+Residual measureResidual(const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& testSet,
+                         const std::vector<ErrorParts>& currentTest, const std::vector<Prepared>& strokes, const DiagnoseOptions& o);
+
+} // namespace rosin::lab::diag

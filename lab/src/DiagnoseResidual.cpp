@@ -1,0 +1,114 @@
+// The diagnosis's floor (noise and chaos) and the residual the final model leaves above it.
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <random>
+
+#include "DiagnoseEngine.h"
+
+namespace rosin::lab::diag {
+
+
+Residual measureResidual(const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& testSet,
+                         const std::vector<ErrorParts>& currentTest, const std::vector<Prepared>& strokes, const DiagnoseOptions& o)
+{
+    // The floor: the final model against itself with the rig's 1 % stroke-to-stroke scatter of
+    // force and acceleration (transients are chaotic), each run with its own noise draw.
+        std::vector<ErrorParts> floorParts(testSet.size());
+        tbb::parallel_for(std::size_t(0), testSet.size(), [&](std::size_t k) {
+            const std::size_t i = testSet[k];
+            std::mt19937_64 jr(o.seed * 977ull + i);
+            std::uniform_real_distribution<double> j(-0.01, 0.01);
+            const StrokeFeatures a = engine.simulate(current, i, nullptr, j(jr), j(jr), 1);
+            const StrokeFeatures b = engine.simulate(current, i, nullptr, j(jr), j(jr), 2);
+            floorParts[k] = compare(a, b, strokes[i].a, strokes[i].F, engine.info());
+        });
+        Residual r;
+        r.error = mean(currentTest);
+        r.floor = std::max(mean(floorParts), 0.01);
+        r.ratio = r.error / r.floor;
+        r.present = r.ratio > o.residualFactor;
+        const char* names[] = {"first-slip time", "bridge force before the first slip", "first-slip jump", "transient length", "waveform after the first slip"};
+        const double w[] = {0.25, 0.25, 0.25, 0.10, 0.15};
+        double partErr[5] = {0, 0, 0, 0, 0}, partFloor[5] = {0, 0, 0, 0, 0};
+        for (std::size_t k = 0; k < testSet.size(); ++k) {
+            const ErrorParts& e = currentTest[k];
+            const ErrorParts& f = floorParts[k];
+            const double pe[] = {e.firstSlip, e.forceBeforeSlip, e.jump, e.transient, e.waveform};
+            const double pf[] = {f.firstSlip, f.forceBeforeSlip, f.jump, f.transient, f.waveform};
+            for (int q = 0; q < 5; ++q) { partErr[q] += w[q] * pe[q]; partFloor[q] += w[q] * pf[q]; }
+        }
+        for (int q = 0; q < 5; ++q) {
+            const double excess = (partErr[q] - partFloor[q]) / static_cast<double>(testSet.size());
+            r.partError[names[q]] = partErr[q] / static_cast<double>(testSet.size());
+            r.partFloor[names[q]] = partFloor[q] / static_cast<double>(testSet.size());
+            if (excess > 0.005) r.parts[names[q]] = excess;
+        }
+        // Where: the quadrant of the Guettler plane (bow acceleration x force) with the largest excess.
+        std::vector<double> as, fs;
+        for (auto i : testSet) { as.push_back(strokes[i].a); fs.push_back(strokes[i].F); }
+        const double am = median(as), fm = median(fs);
+        double worst = -1;
+        for (int qa = 0; qa < 2; ++qa)
+            for (int qf = 0; qf < 2; ++qf) {
+                double sum = 0;
+                int cnt = 0;
+                for (std::size_t k = 0; k < testSet.size(); ++k)
+                    if ((strokes[testSet[k]].a >= am) == (qa == 1) && (strokes[testSet[k]].F >= fm) == (qf == 1)) {
+                        sum += currentTest[k].total() - floorParts[k].total();
+                        ++cnt;
+                    }
+                if (cnt > 0 && sum / cnt > worst) {
+                    worst = sum / cnt;
+                    r.where = std::string(qa ? "high" : "low") + " bow acceleration, " + (qf ? "high" : "low") + " bow force";
+                }
+            }
+        // What it looks like.
+        double slipBias = 0, forceBias = 0;
+        int cnt = 0;
+        std::vector<double> logV, logF;
+        for (auto i : testSet) {
+            const StrokeFeatures& m = strokes[i].feat;
+            if (m.firstSlip <= 0) continue;
+            logV.push_back(std::log(strokes[i].a * m.firstSlip));
+            logF.push_back(std::log(strokes[i].F));
+            ++cnt;
+        }
+        for (std::size_t k = 0; k < testSet.size(); ++k) {
+            const std::size_t i = testSet[k];
+            const StrokeFeatures sim = engine.simulate(current, i);
+            if (strokes[i].feat.firstSlip > 0 && sim.firstSlip > 0) {
+                slipBias += (sim.firstSlip - strokes[i].feat.firstSlip) / strokes[i].feat.firstSlip;
+                forceBias += (sim.forceBeforeSlip - strokes[i].feat.forceBeforeSlip) / strokes[i].F;
+            }
+        }
+        slipBias /= std::max<std::size_t>(1, testSet.size());
+        forceBias /= std::max<std::size_t>(1, testSet.size());
+        double slope = 0.5;
+        if (logV.size() > 4) {
+            const double mv = std::accumulate(logV.begin(), logV.end(), 0.0) / logV.size(), mf = std::accumulate(logF.begin(), logF.end(), 0.0) / logF.size();
+            double sxy = 0, sxx = 0;
+            for (std::size_t k = 0; k < logV.size(); ++k) { sxy += (logF[k] - mf) * (logV[k] - mv); sxx += (logF[k] - mf) * (logF[k] - mf); }
+            if (sxx > 0) slope = sxy / sxx;
+        }
+        std::string look;
+        char buf[240];
+        if (slope < 0.15) {
+            std::snprintf(buf, sizeof buf, "the first slip comes at a nearly fixed bow speed whatever the force (bow speed at slip ~ F^%.2f; a static-friction law gives about F^0.5)", slope);
+            look = buf;
+        } else if (r.parts.count("waveform after the first slip") || r.parts.count("transient length")) {
+            look = "the waveform and transients after the first slip disagree more than chaos allows while the first slip agrees: a period "
+                   "or waveform mismatch such as string stiffness or a compliant bridge gives";
+        } else {
+            std::snprintf(buf, sizeof buf, "the model's first slips come %.1f %% %s and its pre-slip bridge force is %.1f %% of the bow force %s on average",
+                          100 * std::abs(slipBias), slipBias > 0 ? "late" : "early", 100 * std::abs(forceBias), forceBias > 0 ? "high" : "low");
+            look = buf;
+        }
+        r.looksLike = look;
+        return r;
+}
+
+} // namespace rosin::lab::diag
