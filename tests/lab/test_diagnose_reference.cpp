@@ -1,0 +1,121 @@
+// rosin diagnose on data it did not make: sets from the reference simulator (lab/reference: a
+// finite-difference stiff string with bridge resonances and exact-kernel heat) on rigs drawn
+// with every nuisance a lab never knows exactly, written to disk and diagnosed from the files.
+//
+// Rules for every assertion (issue 19): a tolerance is tighter than the prior the value is drawn
+// from (so each effect's parameter is set well away from its prior's middle: a constant guess
+// fails), every named parameter is checked, and nothing follows from another by construction.
+#include <gtest/gtest.h>
+#include <sndfile.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "rosin/lab/Diagnose.h"
+#include "rosin/lab/Measurement.h"
+#include "rosin/lab/ReferenceData.h"
+
+using namespace rosin::lab;
+namespace fs = std::filesystem;
+
+namespace {
+struct Outcome {
+    Diagnosis d;
+    SynthTruth truth;
+};
+
+Outcome run(const std::vector<std::string>& effects, const std::map<std::string, double>& params, std::uint64_t seed, int grid = 8)
+{
+    const fs::path dir = fs::temp_directory_path() / ("rosin-diagref-" + std::to_string(::getpid()) + "-" + std::to_string(seed));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    SynthSpec spec;
+    spec.generator = "reference";
+    spec.effects = effects;
+    spec.params = params;
+    spec.seed = seed;
+    spec.grid = grid;
+    spec.seconds = 0.3;
+    Outcome o;
+    writeMeasurementSet(dir / "set", synthesize(spec, o.truth), SF_FORMAT_PCM_24);
+    DiagnoseOptions opt;
+    opt.seed = 5;
+    o.d = diagnose(readMeasurementSet(dir / "set"), opt);
+    fs::remove_all(dir);
+    return o;
+}
+
+/// The absolute (or relative) tolerance of each named parameter: tighter than its prior.
+struct Tolerance {
+    double value;
+    bool relative;
+};
+const std::map<std::string, Tolerance> kTolerance{{"load_exponent", {0.05, false}}, {"shift_k", {3.0, false}}, {"zt_ratio", {0.2, true}},
+                                                  {"r_A", {0.1, true}},           {"p", {0.1, false}}};
+
+void expectDiagnosis(const Outcome& o)
+{
+    std::vector<std::string> found, want = o.truth.effects;
+    for (const auto& f : o.d.findings) found.push_back(f.effect);
+    std::sort(found.begin(), found.end());
+    std::sort(want.begin(), want.end());
+    std::string tried;
+    for (const auto& t : o.d.trials) tried += " [" + std::to_string(t.round) + " " + t.effect + ": " + t.verdict + "]";
+    EXPECT_EQ(found, want) << "tried:" << tried;
+    for (const auto& f : o.d.findings)
+        for (const auto& [name, v] : f.parameters) {
+            ASSERT_TRUE(o.truth.params.count(name)) << name;
+            const double t = o.truth.params.at(name);
+            if (name == "h0") {
+                // h0 cancels out of the enhanced law when y(theta) is the inversion of steady
+                // sliding (y h = mu_ss(v_theta) h(x) / h(v_theta)): no data can fix it, so its
+                // interval must say so rather than claim a value.
+                EXPECT_GT(v[2] - v[1], 0.2) << "h0 interval " << v[1] << ".." << v[2];
+                continue;
+            }
+            const Tolerance tol = kTolerance.at(name);
+            const double err = tol.relative ? std::abs(v[0] / t - 1.0) : std::abs(v[0] - t);
+            EXPECT_LE(err, tol.value) << name << " found " << v[0] << " hidden " << t;
+        }
+}
+} // namespace
+
+TEST(DiagnoseReference, NamesNothingOnANullRig)
+{
+    const Outcome o = run({}, {}, 41);
+    expectDiagnosis(o);
+    // Calibration, not findings: the rig's static friction from its steady_sliding.csv, within
+    // 3 % (its prior spans +-7 %).
+    double mu = 0;
+    for (const auto& c : o.d.calibration)
+        if (c.name == "mu_static") mu = c.value;
+    EXPECT_NEAR(mu / (1.2 * o.truth.rig.at("mu_level") * (0.85 + 0.35 * o.truth.rig.at("mu_floor_scale")) / 1.2), 1.0, 0.03);
+}
+
+TEST(DiagnoseReference, FindsThermalMemoryAndItsFootprint) { expectDiagnosis(run({"thermal_memory"}, {{"r_A", 0.8}}, 42)); }
+
+TEST(DiagnoseReference, FindsAHertzianContact) { expectDiagnosis(run({"hertzian_contact"}, {{"load_exponent", 0.65}}, 43)); }
+
+// Issue 20's open targets: these fail on today's diagnosis (torsion at Z_t/Z_0 = 1.6 is not
+// named; a -14 K rosin shift comes out near -20 K), so they run with the `long` label, not in CI.
+TEST(DiagnoseReferenceLong, FindsTorsion) { expectDiagnosis(run({"torsional_compliance"}, {{"zt_ratio", 1.6}}, 44)); }
+
+TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temperature_shift"}, {{"r_A", 1.2}, {"shift_k", -14.0}}, 45)); }
+
+// Effects and rigs drawn truly at random from a seed printed here: run by hand or in `long`.
+TEST(DiagnoseReferenceLong, RandomEffectsOnRandomRigs)
+{
+    const auto seed = static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+    std::printf("DiagnoseReferenceLong seed %llu\n", static_cast<unsigned long long>(seed));
+    std::mt19937_64 rng(seed);
+    for (int k = 0; k < 6; ++k) {
+        std::vector<std::string> effects;
+        for (const auto& id : effectIds())
+            if (rng() % 4 == 0) effects.push_back(id);
+        SCOPED_TRACE("set " + std::to_string(k) + " of seed " + std::to_string(seed));
+        expectDiagnosis(run(effects, {}, rng(), 10));
+    }
+}
