@@ -17,7 +17,7 @@ static void BM_SynthVoices(benchmark::State& state)
     ParamValues p = defaultParams();
     p[static_cast<int>(Param::FrictionModel)] = static_cast<float>(model);
     Synth synth;
-    synth.prepare(fs, loadInstrument(presetDirectory(), "violin"), p);
+    synth.prepare(fs, rosin::presets::loadInstrument(rosin::presets::Library(), "violin"), p);
     for (int v = 0; v < voices; ++v) {
         const std::uint8_t on[3] = {0x90, static_cast<std::uint8_t>(79 - 3 * v), 100};
         synth.handleMidi(on, 3);

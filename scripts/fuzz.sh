@@ -9,8 +9,8 @@ out=$(realpath -m "${2:-build/fuzz}")
 mkdir -p "$out/corpus"
 src=plugin/hid
 clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-  -I "$src/include" -I plugin/engine/include \
-  "$src/fuzz/FuzzHid.cpp" "$src/src/Descriptor.cpp" "$src/src/Mapping.cpp" -o "$out/fuzz-hid"
+  -I "$src/include" -I plugin/rt/include -I presets/lib/include \
+  "$src/fuzz/FuzzHid.cpp" "$src/src/Descriptor.cpp" "$src/src/Mapping.cpp" presets/lib/src/Document.cpp -o "$out/fuzz-hid"
 # Seeds: every real descriptor, wrapped in the input format with one all-zero report.
 for f in tests/data/hid/*.rdesc.bin; do
   [[ -f "$f" ]] || continue

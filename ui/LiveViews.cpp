@@ -143,7 +143,7 @@ void LiveViews::updateMap()
     if (name != instrumentName_) {
         instrumentName_ = name;
         try {
-            instrument_ = engine::loadInstrument(engine::presetDirectory(), name);
+            instrument_ = presets::loadInstrument(processor_.presetLibrary(), name);
             instrumentLoaded_ = instrument_.stringCount > 0;
         } catch (const std::exception&) {
             instrumentLoaded_ = false;

@@ -121,7 +121,7 @@ void RosinEditor::addPresetPicker(juce::ComboBox& box, const std::string& kind, 
 {
     box.setTextWhenNothingSelected(prompt);
     int id = 1;
-    for (const auto& name : engine::listPresets(engine::presetDirectory(), kind)) box.addItem(name, id++);
+    for (const auto& name : processor_.presetLibrary().list(kind)) box.addItem(name, id++);
     box.onChange = [this, &box, load = std::move(load)] {
         try {
             load(box.getText());

@@ -46,6 +46,9 @@ int main(int argc, char** argv)
     } catch (const LabError& e) {
         std::fprintf(stderr, "rosin: %s\n", e.what());
         return 2;
+    } catch (const rosin::presets::PresetError& e) {
+        std::fprintf(stderr, "rosin: %s\n", e.what());
+        return 2;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "rosin: unexpected error: %s\n", e.what());
         return 3;

@@ -12,7 +12,7 @@
 
 #include "AuditCounter.h"
 #include "PluginHost.h"
-#include "rosin/engine/Presets.h"
+#include "rosin/presets/Presets.h"
 #include "rosin/hid/HidInput.h"
 
 #include <chrono>
@@ -186,7 +186,7 @@ int main(int argc, char** argv)
         if (!stateIn.empty()) host.setState(readBytes(stateIn));
         if (!preset.empty()) {
             // As a player choosing the preset: the instrument, and the bow and rosin it suggests.
-            const auto p = rosin::engine::loadInstrument(rosin::engine::presetDirectory(), preset);
+            const auto p = rosin::presets::loadInstrument(rosin::presets::Library::standard(), preset);
             host.setParameter("instrument", preset);
             if (host.parameter("instrument").text != preset)
                 throw std::runtime_error("--preset " + preset + ": the plugin has no such instrument (it shows '" +

@@ -30,27 +30,10 @@ target_sources(RosinPlugin PRIVATE
 target_include_directories(RosinPlugin PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR}/ui)
 target_compile_definitions(RosinPlugin PUBLIC ${ROSIN_JUCE_DEFINITIONS}
   JucePlugin_LV2URI="${ROSIN_LV2_URI}"
-  JUCE_VST3_CAN_REPLACE_VST2=0
-  ROSIN_SOURCE_PRESET_DIR="${PROJECT_SOURCE_DIR}/presets")
+  JUCE_VST3_CAN_REPLACE_VST2=0)
 target_link_libraries(RosinPlugin
-  PRIVATE rosin::engine rosin::hid rosin_lab_core rosin_lab_presets juce::juce_audio_utils juce::juce_audio_plugin_client ${CMAKE_DL_LIBS}
+  PRIVATE rosin::engine rosin::hid rosin_lab_core juce::juce_audio_utils juce::juce_audio_plugin_client ${CMAKE_DL_LIBS}
   PUBLIC juce::juce_recommended_config_flags juce::juce_recommended_warning_flags)
-
-# Presets travel inside each bundle, so an installed plugin finds them without the source tree.
-get_target_property(ROSIN_ARTEFACTS RosinPlugin JUCE_PLUGIN_ARTEFACT_FILE)
-foreach(format VST3 LV2)
-  if(TARGET RosinPlugin_${format})
-    get_target_property(bundle RosinPlugin_${format} JUCE_PLUGIN_ARTEFACT_FILE)
-    if(format STREQUAL "VST3")
-      set(dest "${bundle}/Contents/Resources/presets")
-    else()
-      set(dest "${bundle}/presets")
-    endif()
-    add_custom_command(TARGET RosinPlugin_${format} POST_BUILD
-      COMMAND ${CMAKE_COMMAND} -E copy_directory ${PROJECT_SOURCE_DIR}/presets ${dest}
-      VERBATIM)
-  endif()
-endforeach()
 
 # Headless host core: JUCE plugin hosting compiled once, behind a JUCE-free header.
 add_library(rosin_host_core STATIC ${CMAKE_CURRENT_SOURCE_DIR}/host/PluginHost.cpp)
@@ -67,7 +50,7 @@ target_compile_features(rosin_host_core PUBLIC cxx_std_20)
 # The audit counter interposes malloc/pthread_mutex_lock: executables export it (-rdynamic)
 # so the dlopen'ed plugin binds to it.
 add_executable(rosin-host ${CMAKE_CURRENT_SOURCE_DIR}/host/HostMain.cpp ${CMAKE_CURRENT_SOURCE_DIR}/host/AuditCounter.cpp)
-target_link_libraries(rosin-host PRIVATE rosin_host_core rosin::hid CLI11::CLI11 nlohmann_json::nlohmann_json ${CMAKE_DL_LIBS})
+target_link_libraries(rosin-host PRIVATE rosin_host_core rosin::hid rosin::presets CLI11::CLI11 nlohmann_json::nlohmann_json ${CMAKE_DL_LIBS})
 set_target_properties(rosin-host PROPERTIES ENABLE_EXPORTS ON)
 add_dependencies(rosin-host RosinPlugin_VST3 RosinPlugin_LV2)
 

@@ -1,7 +1,5 @@
 #include "RosinProcessor.h"
 
-#include <dlfcn.h>
-
 #include <chrono>
 #include <thread>
 
@@ -9,7 +7,7 @@
 #include <limits>
 
 #include "rosin/engine/Presets.h"
-#include "../../ui/RosinEditor.h"
+#include "RosinEditor.h"
 
 // The headless host defines this (strong, exported) to count allocations and locks between
 // enter (1) and exit (0) on the calling thread. In a DAW it is absent and never called.
@@ -20,21 +18,6 @@ namespace {
 using engine::Param;
 using engine::paramCount;
 using engine::paramInfo;
-
-/// Presets: $ROSIN_PRESETS, then inside the plugin bundle (VST3 Contents/Resources/presets,
-/// LV2 bundle/presets), then the source tree this was built from.
-juce::File findPresetDirectory()
-{
-    if (const char* env = std::getenv("ROSIN_PRESETS"); env && *env) return juce::File(env);
-    Dl_info info{};
-    if (dladdr(reinterpret_cast<void*>(&findPresetDirectory), &info) && info.dli_fname) {
-        const juce::File so(info.dli_fname);
-        for (const auto& candidate : {so.getParentDirectory().getChildFile("presets"),
-                                      so.getParentDirectory().getParentDirectory().getChildFile("Resources/presets")})
-            if (candidate.getChildFile("instruments").isDirectory()) return candidate;
-    }
-    return juce::File(ROSIN_SOURCE_PRESET_DIR);
-}
 
 float engineValue(int index, float raw)
 {
@@ -128,7 +111,6 @@ RosinProcessor::RosinProcessor()
     hidRaw_ = state_.getRawParameterValue(hidParamId);
     hid_ = std::make_unique<hid::HidInput>(hid::makeHidapiBackend());
     pushed_.fill(std::numeric_limits<float>::quiet_NaN());
-    presetDir_ = findPresetDirectory();
     loadedInstrument_.store(juce::roundToInt(instrumentRaw_->load()));
     loader_ = std::make_unique<Loader>(*this);
     loader_->startThread();
@@ -189,10 +171,7 @@ void RosinProcessor::pollHid()
 
 void RosinProcessor::loadHidMapping(const juce::String& name)
 {
-    juce::File file(name);
-    if (!name.endsWith(".json")) file = presetDir_.getChildFile("controllers").getChildFile(name + ".json");
-    if (!file.existsAsFile()) throw std::runtime_error(file.getFullPathName().toStdString() + ": no such controller map");
-    hid_->setMapping(hid::HidMapping::fromJson(file.loadFileAsString().toStdString(), file.getFullPathName().toStdString()));
+    hid_->setMapping(hid::HidMapping::fromDocument(library_.open("controllers", name.toStdString(), "rosin-hid/1")));
 }
 
 void RosinProcessor::drainHid(engine::Synth& synth) noexcept
@@ -225,7 +204,7 @@ void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults
 {
     const std::lock_guard<std::mutex> lock(loadMutex_);
     const int index = instrumentNames().indexOf(name);
-    const auto preset = engine::loadInstrument(presetDir_.getFullPathName().toStdString(), name.toStdString());
+    const auto preset = presets::loadInstrument(library_, name.toStdString());
     if (applyDefaults) {
         setPhysical(Param::BowForce, preset.bowForce);
         setPhysical(Param::BowSpeed, preset.bowSpeed);
@@ -249,7 +228,7 @@ void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults
 
 void RosinProcessor::loadExciter(const juce::String& name)
 {
-    const auto e = engine::loadExciter(presetDir_.getFullPathName().toStdString(), name.toStdString());
+    const auto e = presets::loadExciter(library_, name.toStdString());
     setPhysical(Param::FrictionModel, static_cast<int>(e.model));
     setPhysical(Param::ContactLaw, e.contact == dsp::ContactLaw::PowerLaw ? 1.0 : 0.0);
     setPhysical(Param::Footprint, e.footprintRatio);
@@ -258,7 +237,7 @@ void RosinProcessor::loadExciter(const juce::String& name)
 
 void RosinProcessor::loadMapping(const juce::String& name)
 {
-    const auto m = engine::loadMapping(presetDir_.getFullPathName().toStdString(), name.toStdString());
+    const auto m = engine::loadControllerMap(library_, name.toStdString());
     map_.assign(m.entries);
     if (m.mpeGiven) setPhysical(Param::Mpe, m.mpe ? 1.0 : 0.0);
     if (m.articulation >= 0) setPhysical(Param::Articulation, m.articulation);
@@ -284,7 +263,7 @@ void RosinProcessor::prepareToPlay(double sampleRate, int maximumExpectedSamples
     const int index = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(instrumentRaw_->load()));
     instrumentName_ = instrumentNames()[index];
     try {
-        const auto preset = engine::loadInstrument(presetDir_.getFullPathName().toStdString(), instrumentName_.toStdString());
+        const auto preset = presets::loadInstrument(library_, instrumentName_.toStdString());
         current_ = buildSynth(preset, sampleRate, index).release();
     } catch (const std::exception& e) {
         DBG("Rosin: " << e.what()); // no engine: processBlock outputs silence

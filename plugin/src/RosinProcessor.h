@@ -14,7 +14,8 @@
 #include <memory>
 #include <mutex>
 
-#include "rosin/engine/SpscQueue.h"
+#include "rosin/presets/Library.h"
+#include "rosin/rt/SpscQueue.h"
 #include "rosin/engine/ControllerMap.h"
 #include "rosin/engine/Synth.h"
 #include "rosin/engine/ViewTap.h"
@@ -66,6 +67,8 @@ public:
     /// The HID controller input (its thread starts when the hid_input parameter is on).
     hid::HidInput& hidInput() noexcept { return *hid_; }
 
+    /// The one preset lookup (factory set compiled in, then user folders): the editor asks here.
+    const presets::Library& presetLibrary() const noexcept { return library_; }
     juce::AudioProcessorValueTreeState& parameters() noexcept { return state_; }
     engine::ControllerMap& controllerMap() noexcept { return map_; }
     juce::String currentInstrument() const;
@@ -113,9 +116,9 @@ private:
         std::array<std::uint8_t, 3> bytes{};
         int size = 0;
     };
-    engine::SpscQueue<UiMidi, 256> uiMidi_;
+    rt::SpscQueue<UiMidi, 256> uiMidi_;
     std::atomic<engine::Synth*> pending_{nullptr};
-    engine::SpscQueue<engine::Synth*, 16> trash_;
+    rt::SpscQueue<engine::Synth*, 16> trash_;
     std::atomic<double> sampleRate_{0.0};
     std::atomic<int> loadedInstrument_{-1};   ///< index of the instrument whose Synth is installed or pending
     int installedInstrument_ = -1;            ///< [audio thread] index of current_'s instrument
@@ -124,7 +127,7 @@ private:
     mutable std::mutex loadMutex_; ///< serialises loaders (never taken on the audio thread)
     juce::String instrumentName_{"cello"};
     std::unique_ptr<Loader> loader_;
-    juce::File presetDir_;
+    const presets::Library library_ = presets::Library::standard(); ///< factory set + user folders, fixed at construction
 
     JUCE_DECLARE_NON_COPYABLE_WITH_LEAK_DETECTOR(RosinProcessor)
 };

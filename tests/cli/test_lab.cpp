@@ -12,10 +12,11 @@
 
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Gesture.h"
-#include "rosin/lab/Presets.h"
+#include "rosin/presets/Presets.h"
 
 namespace fs = std::filesystem;
 using namespace rosin::lab;
+namespace presets = rosin::presets;
 
 namespace {
 const fs::path kPresets = fs::path(ROSIN_SOURCE_DIR) / "presets";
@@ -57,7 +58,7 @@ void writeFile(const fs::path& p, const std::string& text) { std::ofstream(p) <<
 
 TEST(Presets, EveryInstrumentHasItsFourStringsAtTheRightPitch)
 {
-    const auto all = loadAllStrings(kPresets);
+    const auto all = presets::allStrings(presets::Library());
     const std::map<std::string, double> pitch{
         {"violin-G", 196.00}, {"violin-D", 293.66}, {"violin-A", 440.00}, {"violin-E", 659.26},
         {"viola-C", 130.81},  {"viola-G", 196.00},  {"viola-D", 293.66},  {"viola-A", 440.00},
@@ -73,7 +74,7 @@ TEST(Presets, EveryInstrumentHasItsFourStringsAtTheRightPitch)
 
 TEST(Presets, CelloDIsThePhysicsReferenceString)
 {
-    const auto d = findString(kPresets, "cello-d").params; // ids are case-insensitive
+    const auto d = presets::findString(presets::Library(), "cello-d").params; // ids are case-insensitive
     EXPECT_NEAR(d.length, 0.69, 1e-12);
     EXPECT_NEAR(d.tension, 102.6, 1e-12);
     EXPECT_NEAR(d.massPerLength * 1e3, 2.50, 0.01);
@@ -87,9 +88,42 @@ TEST(Presets, CelloDIsThePhysicsReferenceString)
 
 TEST(Presets, RosinPresetsCarryTheirGlassTransitions)
 {
-    EXPECT_DOUBLE_EQ(findRosin(kPresets, "violin").glassTransitionCelsius, 49.0);
-    EXPECT_DOUBLE_EQ(findRosin(kPresets, "bass").glassTransitionCelsius, 16.0);
-    EXPECT_THROW(findRosin(kPresets, "gouda"), LabError);
+    const presets::Library library;
+    EXPECT_DOUBLE_EQ(presets::findRosin(library, "violin").glassTransitionCelsius, 49.0);
+    EXPECT_DOUBLE_EQ(presets::findRosin(library, "bass").glassTransitionCelsius, 16.0);
+    EXPECT_THROW(presets::findRosin(library, "gouda"), presets::PresetError);
+}
+
+TEST(Presets, TheFactorySetNeedsNoFilesAndUserFoldersAddToIt)
+{
+    // The factory set is compiled in: nothing on disk is read for it.
+    const presets::Library factory;
+    EXPECT_EQ(factory.list("instruments"), (std::vector<std::string>{"cello", "double-bass", "viola", "violin"}));
+    EXPECT_EQ(presets::loadInstrument(factory, "cello").origin, "factory:instruments/cello.json");
+    EXPECT_GE(factory.list("controllers").size(), 4u);
+
+    // A user folder adds a rosin of its own and replaces the factory violin rosin.
+    TempDir a, b;
+    fs::create_directories(a.path() / "rosin");
+    fs::create_directories(b.path() / "rosin");
+    writeFile(a.path() / "rosin" / "amber.json", R"({"format": "rosin-rosin/1", "glass_transition_C": 41.5})");
+    writeFile(a.path() / "rosin" / "violin.json", R"({"format": "rosin-rosin/1", "glass_transition_C": 47.0})");
+    writeFile(b.path() / "rosin" / "violin.json", R"({"format": "rosin-rosin/1", "glass_transition_C": 45.0})");
+    presets::Library user;
+    user.addFolder(a.path());
+    EXPECT_EQ(user.list("rosin"), (std::vector<std::string>{"amber", "bass", "violin"}));
+    EXPECT_DOUBLE_EQ(presets::findRosin(user, "amber").glassTransitionCelsius, 41.5);
+    EXPECT_DOUBLE_EQ(presets::findRosin(user, "violin").glassTransitionCelsius, 47.0);
+    EXPECT_DOUBLE_EQ(presets::findRosin(user, "bass").glassTransitionCelsius, 16.0); // still the factory's
+    // An instrument from the factory picks up the user's rosin of the same name.
+    EXPECT_DOUBLE_EQ(presets::loadInstrument(user, "violin").rosinTg, 47.0);
+
+    // $ROSIN_PRESETS: the first folder listed wins.
+    ::setenv("ROSIN_PRESETS", (b.path().string() + ":" + a.path().string()).c_str(), 1);
+    const presets::Library fromEnv = presets::Library::standard();
+    ::unsetenv("ROSIN_PRESETS");
+    EXPECT_DOUBLE_EQ(presets::findRosin(fromEnv, "violin").glassTransitionCelsius, 45.0);
+    EXPECT_DOUBLE_EQ(presets::findRosin(fromEnv, "amber").glassTransitionCelsius, 41.5);
 }
 
 TEST(Presets, BrokenStringFileNamesTheFileAndField)
@@ -99,15 +133,15 @@ TEST(Presets, BrokenStringFileNamesTheFileAndField)
     writeFile(f, R"({"format": "rosin-strings/1", "strings": [{"name": "X", "frequency_hz": 100, "length_m": 0.5,
                  "tension_N": "loud", "radius_m": 1e-3}]})");
     try {
-        loadStringFile(f);
+        presets::loadStrings(presets::Library(), f.string());
         FAIL() << "expected an error";
-    } catch (const LabError& e) {
+    } catch (const presets::PresetError& e) {
         const std::string msg = e.what();
         EXPECT_NE(msg.find("broken.json"), std::string::npos) << msg;
         EXPECT_NE(msg.find("tension_N"), std::string::npos) << msg;
     }
     writeFile(f, R"({"format": "rosin-strings/2", "strings": []})");
-    EXPECT_THROW(loadStringFile(f), LabError);
+    EXPECT_THROW(presets::loadStrings(presets::Library(), f.string()), presets::PresetError);
 }
 
 TEST(GestureFile, ReadsRowsAndInterpolatesLinearly)

@@ -11,7 +11,7 @@
 
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Guettler.h"
-#include "rosin/lab/Presets.h"
+#include "rosin/presets/Presets.h"
 #include "rosin/lab/Render.h"
 #include "rosin/lab/ViewFigures.h"
 
@@ -23,7 +23,7 @@ namespace {
 dsp::BowedStringConfig celloD(dsp::FrictionModel model)
 {
     dsp::BowedStringConfig c;
-    c.string = findString(presetDirectory(), "cello-D").params;
+    c.string = presets::findString(presets::Library(), "cello-D").params;
     c.friction.model = model;
     return c;
 }

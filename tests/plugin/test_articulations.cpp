@@ -14,7 +14,8 @@ using namespace rosin;
 using namespace rosin::engine;
 
 namespace {
-const std::string presetDir = ROSIN_SOURCE_DIR "/presets";
+const presets::Library presetDir; // the factory set
+using presets::loadInstrument;
 constexpr int fs = 48000;
 
 std::unique_ptr<Synth> make(const std::string& instrument, ParamValues p = defaultParams())

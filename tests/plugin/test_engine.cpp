@@ -16,7 +16,9 @@ using namespace rosin::engine;
 namespace fs = std::filesystem;
 
 namespace {
-const fs::path presetDir = ROSIN_SOURCE_DIR "/presets";
+const presets::Library presetDir; // the factory set compiled into the library
+using presets::loadExciter;
+using presets::loadInstrument;
 
 struct Event {
     int frame;
@@ -76,11 +78,11 @@ TEST(EnginePresets, EveryInstrumentLoadsWithItsFourStringsInPitchOrder)
         EXPECT_TRUE(p.strings[0].validate().empty()) << name;
     }
     EXPECT_NEAR(loadInstrument(presetDir, "double-bass").bowPosition, 0.13, 1e-9);
-    EXPECT_EQ(listPresets(presetDir, "instruments").size(), 4u);
-    EXPECT_EQ(loadMapping(presetDir, "pizzicato").articulation, 5);
-    EXPECT_EQ(loadMapping(presetDir, "articulations-by-channel").articulationChannels, 1);
+    EXPECT_EQ(presetDir.list("instruments").size(), 4u);
+    EXPECT_EQ(loadControllerMap(presetDir, "pizzicato").articulation, 5);
+    EXPECT_EQ(loadControllerMap(presetDir, "articulations-by-channel").articulationChannels, 1);
     EXPECT_EQ(loadExciter(presetDir, "enhanced-rod").contact, dsp::ContactLaw::PowerLaw);
-    const MappingPreset keyboard = loadMapping(presetDir, "keyboard");
+    const MappingPreset keyboard = loadControllerMap(presetDir, "keyboard");
     ASSERT_EQ(keyboard.entries.size(), 4u);
     EXPECT_EQ(keyboard.entries[0].param, static_cast<int>(Param::BowForce));
 }
@@ -94,7 +96,7 @@ TEST(EnginePresets, BadFilesNameTheFileAndTheField)
         std::ofstream(f) << text;
         try {
             if (kind == "instrument") loadInstrument(presetDir, f.string());
-            else if (kind == "mapping") loadMapping(presetDir, f.string());
+            else if (kind == "mapping") loadControllerMap(presetDir, f.string());
             else loadExciter(presetDir, f.string());
             ADD_FAILURE() << "no error for " << text;
         } catch (const std::runtime_error& e) {

@@ -12,7 +12,7 @@
 
 #include "rosin/dsp.h"
 #include "rosin/lab/Error.h"
-#include "rosin/lab/Presets.h"
+#include "rosin/presets/Presets.h"
 
 namespace rosin::cli {
 using namespace rosin::lab;
@@ -86,7 +86,7 @@ struct ModelOptions {
         app->add_flag("--no-torsion", noTorsion, "Leave out torsional waves");
         app->add_flag("--no-losses", noLosses, "Lossless string (ideal rigid ends)");
         app->add_flag("--dispersion", dispersion, "Bending-stiffness dispersion from the string's inharmonicity B");
-        app->add_option("--presets", presets, "Presets directory (default: $ROSIN_PRESETS or the source tree's presets/)");
+        app->add_option("--presets", presets, "A presets folder searched before $ROSIN_PRESETS, ~/.local/share/rosin/presets and the built-in set");
         app->add_option("--set", overrides, "Override a parameter, NAME=VALUE (repeatable): contact_radius_m, layer_thickness_m, "
                                             "rosin_heat_capacity, string_effusivity, rod_effusivity, advection_width_factor, "
                                             "reference_load_n, poles_per_decade, tension_n, length_m, torsion_speed_ratio, "
@@ -95,9 +95,10 @@ struct ModelOptions {
 
     dsp::BowedStringConfig build() const
     {
-        const fs::path dir = presetDirectory(presets);
+        presets::Library library = presets::Library::standard();
+        if (!presets.empty()) library.addFolder(presets);
         dsp::BowedStringConfig c;
-        c.string = findString(dir, string).params;
+        c.string = presets::findString(library, string).params;
         const std::map<std::string, dsp::FrictionModel> models{{"friction-curve", dsp::FrictionModel::FrictionCurve},
                                                                {"thermal", dsp::FrictionModel::Thermal},
                                                                {"enhanced", dsp::FrictionModel::Enhanced}};
@@ -107,7 +108,7 @@ struct ModelOptions {
         c.friction.speedFunction = speedFunction == "bow" ? dsp::SpeedFunction::Bow : dsp::SpeedFunction::Rod;
         c.friction.contactLaw = contact == "amontons" ? dsp::ContactLaw::Amontons : dsp::ContactLaw::PowerLaw;
         c.friction.contactExponent = contact == "hertz" ? 2.0 / 3.0 : contactExponent;
-        c.friction.thermal.glassTransitionCelsius = findRosin(dir, rosin).glassTransitionCelsius;
+        c.friction.thermal.glassTransitionCelsius = presets::findRosin(library, rosin).glassTransitionCelsius;
         c.friction.thermal.ambientCelsius = ambient;
         c.friction.thermal.footprintRatio = footprint;
         c.waveguide.torsion = !noTorsion;

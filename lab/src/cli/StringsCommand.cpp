@@ -34,7 +34,7 @@ struct StringsCommand {
     CLI::App* add(CLI::App& app)
     {
         CLI::App* stringsCmd = app.add_subcommand("strings", "List the string presets with their physical constants");
-        stringsCmd->add_option("--presets", stringsPresets, "Presets directory");
+        stringsCmd->add_option("--presets", stringsPresets, "A presets folder searched before the others");
         return stringsCmd;
     }
 
@@ -42,7 +42,9 @@ struct StringsCommand {
     {
         std::printf("%-16s %-5s %9s %7s %7s %9s %8s %8s\n", "id", "note", "f0 (Hz)", "L (m)", "T (N)", "m (g/m)",
                     "Z0 (kg/s)", "c (m/s)");
-        for (const auto& p : loadAllStrings(presetDirectory(stringsPresets))) {
+        presets::Library library = presets::Library::standard();
+        if (!stringsPresets.empty()) library.addFolder(stringsPresets);
+        for (const auto& p : presets::allStrings(library)) {
             const auto& q = p.params;
             std::printf("%-16s %-5s %9.2f %7.3f %7.1f %9.3f %8.3f %8.1f\n", p.id.c_str(), p.note.c_str(),
                         q.fundamental(), q.length, q.tension, 1e3 * q.massPerLength, q.impedance(), q.waveSpeed());

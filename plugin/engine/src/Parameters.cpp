@@ -1,6 +1,7 @@
 #include "rosin/engine/Parameters.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 namespace rosin::engine {
@@ -52,6 +53,30 @@ int paramIndex(std::string_view id) noexcept
 {
     for (int i = 0; i < paramCount; ++i)
         if (table[static_cast<std::size_t>(i)].id == id) return i;
+    return -1;
+}
+
+std::vector<std::string> choiceNames(Param p)
+{
+    std::vector<std::string> names;
+    const std::string_view all = paramInfo(p).choices;
+    for (std::size_t start = 0; start < all.size();) {
+        const std::size_t bar = std::min(all.find('|', start), all.size());
+        names.emplace_back(all.substr(start, bar - start));
+        start = bar + 1;
+    }
+    return names;
+}
+
+int choiceIndex(Param p, std::string_view name)
+{
+    auto lower = [](std::string s) {
+        for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        return s;
+    };
+    const auto names = choiceNames(p);
+    for (std::size_t i = 0; i < names.size(); ++i)
+        if (lower(names[i]) == lower(std::string(name))) return static_cast<int>(i);
     return -1;
 }
 

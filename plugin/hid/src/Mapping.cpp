@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+
+#include "rosin/presets/Document.h"
 #include <stdexcept>
 
 namespace rosin::hid {
@@ -216,35 +218,23 @@ nlohmann::json curveJson(const Curve& c)
             {"deadzone", c.deadzone}, {"invert", c.invert}};
 }
 
-Curve curveFrom(const nlohmann::json& j, const std::string& where, Curve c)
+Curve curveFrom(const presets::Document& d, const nlohmann::json& j, const std::string& where, Curve c)
 {
-    if (!j.is_object()) throw std::runtime_error(where + " must be an object");
     auto pair = [&](const char* key, double& a, double& b) {
         if (!j.contains(key)) return;
         const auto& v = j[key];
-        if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
-            throw std::runtime_error(where + "." + key + " must be [low, high]");
+        if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number()) d.fail(where + "." + key + " must be [low, high]");
         a = v[0].get<double>();
         b = v[1].get<double>();
-        if (!std::isfinite(a) || !std::isfinite(b)) throw std::runtime_error(where + "." + key + " must be finite");
+        if (!std::isfinite(a) || !std::isfinite(b)) d.fail(where + "." + key + " must be finite");
     };
     pair("in", c.inMin, c.inMax);
     pair("out", c.outMin, c.outMax);
-    if (c.inMin == c.inMax) throw std::runtime_error(where + ".in must span a range");
-    if (j.contains("exponent")) {
-        if (!j["exponent"].is_number() || !(j["exponent"].get<double>() > 0.0) || j["exponent"].get<double>() > 10.0)
-            throw std::runtime_error(where + ".exponent must be in (0, 10]");
-        c.exponent = j["exponent"].get<double>();
-    }
-    if (j.contains("deadzone")) {
-        if (!j["deadzone"].is_number() || j["deadzone"].get<double>() < 0.0 || j["deadzone"].get<double>() >= 1.0)
-            throw std::runtime_error(where + ".deadzone must be in [0, 1)");
-        c.deadzone = j["deadzone"].get<double>();
-    }
-    if (j.contains("invert")) {
-        if (!j["invert"].is_boolean()) throw std::runtime_error(where + ".invert must be true or false");
-        c.invert = j["invert"].get<bool>();
-    }
+    if (c.inMin == c.inMax) d.fail(where + ".in must span a range");
+    const std::string w = where + ": ";
+    c.exponent = d.number(j, "exponent", w, false, c.exponent, 1e-6, 10.0);
+    c.deadzone = d.number(j, "deadzone", w, false, c.deadzone, 0.0, 0.999);
+    c.invert = d.flag(j, "invert", w, c.invert);
     return c;
 }
 } // namespace
@@ -268,51 +258,57 @@ std::string HidMapping::toJson() const
 
 HidMapping HidMapping::fromJson(const std::string& text, const std::string& where)
 {
-    nlohmann::json j;
-    try {
-        j = nlohmann::json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw std::runtime_error(where + ": not valid JSON (" + e.what() + ")");
-    }
-    auto fail = [&](const std::string& what) -> std::runtime_error { return std::runtime_error(where + ": " + what); };
-    if (!j.is_object() || j.value("format", "") != "rosin-hid/1") throw fail("field 'format' must be 'rosin-hid/1'");
-    if (!j.contains("device") || !j["device"].is_string()) throw fail("field 'device' is missing");
+    return fromDocument(presets::Document::parse(text, where));
+}
+
+HidMapping HidMapping::fromDocument(const presets::Document& d)
+{
+    d.requireFormat("rosin-hid/1");
+    const auto& j = d.root();
     HidMapping m;
-    try {
-        m = defaultFor(parseKind(j["device"].get<std::string>()));
-        if (j.contains("name")) m.name = j["name"].get<std::string>();
-        auto section = [&](const char* key, Source& src, Curve& curve) {
-            if (!j.contains(key)) return;
-            const auto& s = j[key];
-            if (s.contains("source")) src = parseSource(s["source"].get<std::string>());
-            if (s.contains("curve")) curve = curveFrom(s["curve"], std::string(key) + ".curve", curve);
-        };
-        section("force", m.force, m.forceCurve);
-        section("speed", m.speed, m.speedCurve);
-        section("position", m.position, m.positionCurve);
-        section("string", m.stringSelect, m.stringCurve);
-        if (j.contains("speed")) {
-            const auto& s = j["speed"];
-            m.speedFromMotion = s.value("from_motion", m.speedFromMotion);
-            m.speedScale = s.value("scale_m", m.speedScale);
-            m.speedSmoothing = s.value("smoothing_s", m.speedSmoothing);
-            m.bowChangeThreshold = s.value("bow_change_m_s", m.bowChangeThreshold);
-            if (!(m.speedScale > 0.0 && m.speedScale < 10.0)) throw std::runtime_error("speed.scale_m must be in (0, 10)");
-            if (!(m.speedSmoothing >= 0.0 && m.speedSmoothing < 1.0)) throw std::runtime_error("speed.smoothing_s must be in [0, 1)");
+    auto kindOf = [&](const std::string& name) {
+        try {
+            return parseKind(name);
+        } catch (const std::runtime_error& e) {
+            d.fail(std::string("field 'device': ") + e.what());
         }
-        if (j.contains("string")) m.strings = std::clamp(j["string"].value("count", m.strings), 1, 5);
-        m.requireTip = j.value("require_tip", m.requireTip);
-        m.tipNote = std::clamp(j.value("tip_note", m.tipNote), -1, 127);
-        if (j.contains("button_notes")) {
-            const auto& b = j["button_notes"];
-            if (!b.is_array() || b.size() > m.buttonNotes.size()) throw std::runtime_error("button_notes must be an array of up to 8 notes");
-            m.buttonNotes.fill(-1);
-            for (std::size_t i = 0; i < b.size(); ++i) m.buttonNotes[i] = std::clamp(b[i].get<int>(), -1, 127);
+    };
+    auto sourceOf = [&](const std::string& name, const std::string& where) {
+        try {
+            return parseSource(name);
+        } catch (const std::runtime_error& e) {
+            d.fail(where + "field 'source': " + e.what());
         }
-    } catch (const nlohmann::json::exception& e) {
-        throw fail(std::string("a field has the wrong type (") + e.what() + ")");
-    } catch (const std::runtime_error& e) {
-        throw fail(e.what());
+    };
+    m = defaultFor(kindOf(d.text(j, "device")));
+    m.name = d.text(j, "name", "", false, m.name);
+    auto section = [&](const char* key, Source& src, Curve& curve) {
+        const auto& s = d.object(j, key, "", false);
+        const std::string where = std::string(key) + ": ";
+        if (s.contains("source")) src = sourceOf(d.text(s, "source", where), where);
+        if (s.contains("curve")) curve = curveFrom(d, d.object(s, "curve", where), std::string(key) + ".curve", curve);
+    };
+    section("force", m.force, m.forceCurve);
+    section("speed", m.speed, m.speedCurve);
+    section("position", m.position, m.positionCurve);
+    section("string", m.stringSelect, m.stringCurve);
+    const auto& speed = d.object(j, "speed", "", false);
+    m.speedFromMotion = d.flag(speed, "from_motion", "speed: ", m.speedFromMotion);
+    m.speedScale = d.number(speed, "scale_m", "speed: ", false, m.speedScale, 1e-6, 10.0);
+    m.speedSmoothing = d.number(speed, "smoothing_s", "speed: ", false, m.speedSmoothing, 0.0, 0.999);
+    m.bowChangeThreshold = d.number(speed, "bow_change_m_s", "speed: ", false, m.bowChangeThreshold, 0.0, 10.0);
+    m.strings = d.integer(d.object(j, "string", "", false), "count", "string: ", false, m.strings, 1, 5);
+    m.requireTip = d.flag(j, "require_tip", "", m.requireTip);
+    m.tipNote = d.integer(j, "tip_note", "", false, m.tipNote, -1, 127);
+    if (j.contains("button_notes")) {
+        const auto& b = d.array(j, "button_notes");
+        if (b.size() > m.buttonNotes.size()) d.fail("field 'button_notes' holds at most 8 notes");
+        m.buttonNotes.fill(-1);
+        for (std::size_t i = 0; i < b.size(); ++i) {
+            if (!b[i].is_number_integer() || b[i].get<int>() < -1 || b[i].get<int>() > 127)
+                d.fail("button_notes[" + std::to_string(i) + "] must be a note number 0-127, or -1");
+            m.buttonNotes[i] = b[i].get<int>();
+        }
     }
     return m;
 }

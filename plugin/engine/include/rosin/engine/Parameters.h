@@ -3,7 +3,9 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace rosin::engine {
 
@@ -60,6 +62,11 @@ inline const ParamInfo& paramInfo(int i) noexcept { return paramInfo(static_cast
 
 /// Index of a parameter by its stable ID, or -1.
 int paramIndex(std::string_view id) noexcept;
+
+/// The names of a choice parameter's steps, in order (empty for a continuous one).
+std::vector<std::string> choiceNames(Param p);
+/// The step of a choice parameter named `name` (case-insensitive), or -1.
+int choiceIndex(Param p, std::string_view name);
 
 /// Clamp into range, snap choices, and replace NaN/inf by the default: whatever a host or a
 /// controller sends, the model gets a playable value.

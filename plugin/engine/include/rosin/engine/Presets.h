@@ -1,41 +1,17 @@
-// Instrument, exciter and controller-map presets (JSON under presets/). Parsing allocates and
-// throws: call it on the message thread or a loader thread, never on the audio thread.
+// The instrument's presets come from the presets library (rosin/presets: one JSON reader, the
+// factory set in the binary, user folders). What the engine adds: a controller map resolved
+// against its own parameter table.
 #pragma once
-#include <array>
-#include <filesystem>
 #include <string>
 #include <vector>
 
-#include "rosin/dsp/Body.h"
-#include "rosin/dsp/BowJunction.h"
-#include "rosin/dsp/StringParams.h"
+#include "rosin/presets/Presets.h"
 
 namespace rosin::engine {
 
-inline constexpr int maxStrings = 5; // five-string basses exist; the shipped presets have four
-
-struct InstrumentPreset {
-    std::string name = "cello";
-    std::filesystem::path file;
-    int stringCount = 0;
-    std::array<dsp::StringParams, maxStrings> strings{};
-    std::array<std::string, maxStrings> stringNames{};
-    double tuningA4 = 440.0;
-    double maxStopSemitones = 24.0; ///< highest stop on a string, above its open pitch
-    dsp::BodyParams body;
-    double panSpread = 0.5;
-    // Defaults the preset gives the bow parameters when it is loaded.
-    double bowForce = 0.8, bowSpeed = 0.15, bowPosition = 0.09, attackAccel = 4.0;
-    double rosinTg = 49.0;
-};
-
-struct ExciterPreset {
-    std::string name;
-    dsp::FrictionModel model = dsp::FrictionModel::Thermal;
-    dsp::ContactLaw contact = dsp::ContactLaw::Amontons;
-    double footprintRatio = 1.0;
-    double ambient = 20.0;
-};
+using presets::ExciterPreset;
+using presets::InstrumentPreset;
+using presets::maxStrings;
 
 struct MappingEntry {
     int cc = -1;          ///< controller number 0-119 (an MSB number for 14-bit pairs)
@@ -53,16 +29,13 @@ struct MappingPreset {
     std::vector<MappingEntry> entries;
 };
 
-/// By name ("cello") under dir/instruments, or a path to a .json file. Throws
-/// std::runtime_error naming the file and field at fault.
-InstrumentPreset loadInstrument(const std::filesystem::path& presetDir, const std::string& nameOrPath);
-ExciterPreset loadExciter(const std::filesystem::path& presetDir, const std::string& nameOrPath);
-MappingPreset loadMapping(const std::filesystem::path& presetDir, const std::string& nameOrPath);
-
-/// Names of the presets of one kind ("instruments", "exciters", "mappings"), sorted.
-std::vector<std::string> listPresets(const std::filesystem::path& presetDir, const std::string& kind);
-
-/// The preset directory: explicit, $ROSIN_PRESETS, the source tree, or beside the binary.
-std::filesystem::path presetDirectory(const std::string& explicitDir = {});
+/// A controller map with its parameter IDs and articulation name looked up in the engine's
+/// table; ranges default to the parameter's own and must lie inside it. Throws
+/// presets::PresetError naming the map and the entry at fault.
+MappingPreset resolveMapping(const presets::MappingPreset& written);
+inline MappingPreset loadControllerMap(const presets::Library& lib, const std::string& nameOrPath)
+{
+    return resolveMapping(presets::loadMapping(lib, nameOrPath));
+}
 
 } // namespace rosin::engine

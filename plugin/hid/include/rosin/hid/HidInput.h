@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "rosin/engine/SpscQueue.h"
+#include "rosin/rt/SpscQueue.h"
 #include "rosin/hid/Mapping.h"
 
 namespace rosin::hid {
@@ -44,7 +44,7 @@ std::unique_ptr<DeviceBackend> makeHidapiBackend();
 
 class HidInput {
 public:
-    using Queue = engine::SpscQueue<BowCommand, 1024>;
+    using Queue = rt::SpscQueue<BowCommand, 1024>;
 
     explicit HidInput(std::unique_ptr<DeviceBackend> backend);
     ~HidInput();

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "rosin/hid/Descriptor.h"
+#include "rosin/presets/Document.h"
 
 namespace rosin::hid {
 
@@ -88,8 +89,9 @@ struct HidMapping {
 
     static HidMapping defaultFor(DeviceKind kind);
     std::string toJson() const;
-    /// From JSON (rosin-hid/1). Throws std::runtime_error naming `where` and the field.
+    /// From JSON (rosin-hid/1). Throws presets::PresetError naming `where` and the field.
     static HidMapping fromJson(const std::string& text, const std::string& where);
+    static HidMapping fromDocument(const presets::Document& document);
 };
 
 /// What the HID thread sends to the audio thread (through the SPSC queue).

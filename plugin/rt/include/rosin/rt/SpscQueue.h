@@ -1,11 +1,12 @@
 // Single-producer single-consumer ring of trivially copyable items: wait-free on both ends,
-// no allocation after construction. The audio thread uses it to hand finished objects back.
+// no allocation after construction. One of the two cross-thread channels the project allows
+// (the other is a pointer hand-off): events, finished objects and requests travel through it.
 #pragma once
 #include <array>
 #include <atomic>
 #include <cstddef>
 
-namespace rosin::engine {
+namespace rosin::rt {
 
 template <typename T, std::size_t Capacity>
 class SpscQueue {
@@ -38,4 +39,4 @@ private:
     alignas(64) std::atomic<std::size_t> tail_{0};
 };
 
-} // namespace rosin::engine
+} // namespace rosin::rt

@@ -1,0 +1,18 @@
+# cmake -DROOT=presets -DFILES="a/x.json;b/y.json" -DOUT=factory.cpp -P Embed.cmake
+# Writes each file's bytes as a C array and a table of (path inside presets/, text, size).
+set(body "// Generated from presets/ by presets/Embed.cmake: do not edit.\n#include \"rosin/presets/Library.h\"\n\nnamespace {\n")
+set(table "")
+set(index 0)
+foreach(f ${FILES})
+  file(READ ${ROOT}/${f} hex HEX)
+  file(SIZE ${ROOT}/${f} size)
+  string(REGEX REPLACE "([0-9a-f][0-9a-f])" "0x\\1," bytes "${hex}")
+  string(APPEND body "const unsigned char file${index}[] = {${bytes}0};\n")
+  string(APPEND table "    {\"${f}\", reinterpret_cast<const char*>(file${index}), ${size}ul},\n")
+  math(EXPR index "${index} + 1")
+endforeach()
+string(APPEND body "const rosin::presets::FactoryEntry entries[] = {\n${table}};\n} // namespace\n\n")
+string(APPEND body "const rosin::presets::FactoryEntry* rosin::presets::factoryEntries(unsigned long& count) noexcept\n{\n")
+string(APPEND body "    count = ${index};\n    return entries;\n}\n")
+file(WRITE ${OUT}.tmp "${body}")
+file(RENAME ${OUT}.tmp ${OUT})
