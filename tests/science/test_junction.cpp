@@ -204,23 +204,30 @@ TYPED_TEST(VoiceLoop, MatchesProcessSampleBitForBit)
         BowedString<T> reference, voice, traced;
         for (auto* s : {&reference, &voice, &traced}) s->prepare(fs, c);
         ASSERT_TRUE(voice.waveguide().packed());
-        std::vector<T> expected(n), out(n), outTraced(n);
+        BowedString<T> listened; // the instrument's use: bridge force plus the stick flags
+        listened.prepare(fs, c);
+        std::vector<T> expected(n), out(n), outTraced(n), outListened(n);
         std::vector<BowFrame<T>> frames(n);
+        std::vector<std::uint8_t> expectedStick(n), stick(n);
         int slips = 0;
         for (int i = 0; i < n; ++i) {
             BowFrame<T> f;
             expected[i] = reference.processSample(force[i], speed[i], beta[i], &f);
+            expectedStick[i] = f.stick ? 1 : 0;
             slips += f.stick ? 0 : 1;
         }
         for (int start = 0; start < n; start += 333) {
             const int len = std::min(333, n - start);
             voice.processBlock(&force[start], &speed[start], &beta[start], &out[start], len);
             traced.processBlock(&force[start], &speed[start], &beta[start], &outTraced[start], len, &frames[start]);
+            listened.processBlock(&force[start], &speed[start], &beta[start], &outListened[start], len, nullptr, &stick[start]);
         }
         EXPECT_GT(slips, n / 50) << "the gesture must make the string slip, or the slip path goes untested";
         for (int i = 0; i < n; ++i) {
             ASSERT_EQ(out[i], expected[i]) << "torsion " << torsion << " sample " << i;
             ASSERT_EQ(outTraced[i], expected[i]) << "torsion " << torsion << " sample " << i;
+            ASSERT_EQ(outListened[i], expected[i]) << "torsion " << torsion << " sample " << i;
+            ASSERT_EQ(stick[i], expectedStick[i]) << "torsion " << torsion << " sample " << i;
         }
     }
 }

@@ -2,6 +2,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "BowJunction.h"
 #include "StringWaveguide.h"
@@ -67,18 +68,30 @@ public:
     }
 
     /// [audio thread] n samples; each control is an array (per-sample trajectories), so a
-    /// block split anywhere gives the same output.
+    /// block split anywhere gives the same output. `stick`, when given, receives 1 for each
+    /// sample the contact sticks (the instrument listens for slip onsets).
     void processBlock(const T* force, const T* speed, const T* beta, T* out, int n,
-                      BowFrame<T>* frames = nullptr) noexcept
+                      BowFrame<T>* frames = nullptr, std::uint8_t* stick = nullptr) noexcept
     {
         // A playing voice (plain string, thermal model, no research frames) gets a loop with its
         // switches fixed at compile time: the same calls as processSample, so the same output.
         if (!frames && waveguide_.packed() && junction_.params().model == FrictionModel::Thermal) {
-            if (waveguide_.options().torsion) processPlainThermal<true>(force, speed, beta, out, n);
-            else processPlainThermal<false>(force, speed, beta, out, n);
+            const bool torsion = waveguide_.options().torsion;
+            if (stick) {
+                if (torsion) processPlainThermal<true, true>(force, speed, beta, out, stick, n);
+                else processPlainThermal<false, true>(force, speed, beta, out, stick, n);
+            } else {
+                if (torsion) processPlainThermal<true, false>(force, speed, beta, out, stick, n);
+                else processPlainThermal<false, false>(force, speed, beta, out, stick, n);
+            }
             return;
         }
-        for (int i = 0; i < n; ++i) out[i] = processSample(force[i], speed[i], beta[i], frames ? frames + i : nullptr);
+        BowFrame<T> frame;
+        for (int i = 0; i < n; ++i) {
+            BowFrame<T>* f = frames ? frames + i : (stick ? &frame : nullptr);
+            out[i] = processSample(force[i], speed[i], beta[i], f);
+            if (stick) stick[i] = f->stick ? 1 : 0;
+        }
     }
 
     /// [audio thread] Drive the string with a prescribed force instead of the bow (the pulse
@@ -105,8 +118,9 @@ private:
         if (static_cast<double>(beta) != waveguide_.beta()) waveguide_.setBeta(static_cast<double>(beta));
     }
 
-    template <bool Torsion>
-    ROSIN_VOICE_CLONES void processPlainThermal(const T* force, const T* speed, const T* beta, T* out, int n) noexcept
+    template <bool Torsion, bool Stick>
+    ROSIN_VOICE_CLONES void processPlainThermal(const T* force, const T* speed, const T* beta, T* out, std::uint8_t* stick,
+                                                int n) noexcept
     {
         // The controls are made safe a chunk at a time in one vectorised pass, not per sample.
         constexpr int kChunk = 64;
@@ -120,6 +134,7 @@ private:
                 const JunctionResult<T> r = junction_.solveThermalCleanControls(vh, speedClean[j], forceClean[j], zEff_);
                 waveguide_.template endSampleWith<Torsion>(r.force);
                 out[start + j] = waveguide_.bridgeForce();
+                if constexpr (Stick) stick[start + j] = r.stick ? 1 : 0;
             }
         }
     }
