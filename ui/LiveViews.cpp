@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "../plugin/src/RosinProcessor.h"
+#include "RosinProcessor.h"
 #include "JucePainter.h"
 #include "rosin/engine/Synth.h"
 

@@ -1,6 +1,6 @@
 #include "RosinEditor.h"
 
-#include "../plugin/src/RosinProcessor.h"
+#include "RosinProcessor.h"
 #include "rosin/engine/Presets.h"
 
 namespace rosin::ui {
@@ -107,8 +107,13 @@ RosinEditor::ParamChoice& RosinEditor::addChoice(const char* id, const juce::Str
     auto p = std::make_unique<ParamChoice>();
     p->label = std::make_unique<juce::Label>(juce::String(), text);
     p->box = std::make_unique<juce::ComboBox>();
-    if (auto* param = dynamic_cast<juce::AudioParameterChoice*>(processor_.parameters().getParameter(id)))
+    // The engine's choices without their spare slots (Parameters.h); the plugin's own ones as they are.
+    if (const int index = engine::paramIndex(id); index >= 0) {
+        int item = 1;
+        for (const auto& name : engine::choiceNames(static_cast<engine::Param>(index))) p->box->addItem(name, item++);
+    } else if (auto* param = dynamic_cast<juce::AudioParameterChoice*>(processor_.parameters().getParameter(id))) {
         p->box->addItemList(param->choices, 1);
+    }
     p->attachment = std::make_unique<juce::AudioProcessorValueTreeState::ComboBoxAttachment>(processor_.parameters(), id, *p->box);
     addAndMakeVisible(*p->label);
     addAndMakeVisible(*p->box);

@@ -139,13 +139,20 @@ int main(int argc, char** argv)
             HidInput input(std::move(backend));
             input.start();
             const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(hidSeconds);
-            BowCommand c, last;
+            Event e, last;
             while (std::chrono::steady_clock::now() < end) {
                 bool got = false;
-                while (input.queue().pop(c)) { last = c; got = true; }
-                if (got)
-                    std::printf("%-40s force %5.2f N  speed %+6.3f m/s  beta %.3f  string %d%s\n", input.status().c_str(), last.force,
-                                last.speed, last.beta, last.string, last.bowChange ? "  bow change" : "");
+                while (input.queue().pop(e)) {
+                    if (e.kind == Event::Kind::Bow) {
+                        last = e;
+                        got = true;
+                    } else if (e.kind != Event::Kind::Released) {
+                        std::printf("note %s %d\n", e.kind == Event::Kind::NoteOn ? "on " : "off", e.note);
+                    }
+                }
+                if (got) // normalised: 0.5 is the instrument's nominal bow
+                    std::printf("%-40s force %4.2f  speed %+5.2f  position %4.2f  string %d%s\n", input.status().c_str(), last.force,
+                                last.speed, last.position, last.string, last.bowChange ? "  bow change" : "");
                 std::this_thread::sleep_for(std::chrono::milliseconds(100));
             }
             std::printf("%s; %llu reports\n", input.status().c_str(), static_cast<unsigned long long>(input.reportsRead()));

@@ -1,13 +1,13 @@
 #include "RosinProcessor.h"
 
 #include <chrono>
-#include <thread>
-
 #include <cmath>
 #include <limits>
+#include <thread>
 
-#include "rosin/engine/Presets.h"
 #include "RosinEditor.h"
+#include "StateFormat.h"
+#include "rosin/engine/Presets.h"
 
 // The headless host defines this (strong, exported) to count allocations and locks between
 // enter (1) and exit (0) on the calling thread. In a DAW it is absent and never called.
@@ -15,9 +15,18 @@ extern "C" void rosin_audit_scope(int entering) __attribute__((weak));
 
 namespace rosin::plugin {
 namespace {
+using engine::Control;
+using engine::ControlEvent;
 using engine::Param;
 using engine::paramCount;
 using engine::paramInfo;
+
+constexpr double swapFadeSeconds = 0.01; ///< the old engine fades under the new one: no click, at any rate
+
+double steadySeconds() noexcept
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 float engineValue(int index, float raw)
 {
@@ -42,25 +51,26 @@ const juce::StringArray& RosinProcessor::instrumentNames()
     return names;
 }
 
-/// Off the audio thread: builds engines when the instrument parameter moves, frees retired ones.
+/// Off the audio thread: builds engines when the instrument parameter moves, and keeps house.
 class RosinProcessor::Loader : public juce::Thread {
 public:
-    explicit Loader(RosinProcessor& owner) : juce::Thread("Rosin preset loader"), owner_(owner) {}
+    explicit Loader(RosinProcessor& owner) : juce::Thread("Rosin housekeeping"), owner_(owner) {}
 
     void run() override
     {
         while (!threadShouldExit()) {
-            wait(20); // polls: the audio thread never signals (signalling takes a lock)
-            owner_.collectGarbage();
+            wait(5); // polls: the audio thread never signals (signalling takes a lock)
+            owner_.housekeeping();
             owner_.pollHid();
             const double rate = owner_.sampleRate_.load();
-            const int wanted = juce::roundToInt(owner_.instrumentRaw_->load());
-            if (rate > 0.0 && wanted != owner_.loadedInstrument_.load()) {
+            const int wanted = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(owner_.instrumentRaw_->load()));
+            if (rate > 0.0 && wanted != owner_.requestedInstrument_.load()) {
                 try {
                     owner_.loadInstrument(instrumentNames()[wanted], false);
                 } catch (const std::exception& e) {
                     DBG("Rosin: " << e.what());
-                    owner_.loadedInstrument_.store(wanted); // do not retry a broken file every 20 ms
+                    owner_.requestedInstrument_.store(wanted); // do not retry a broken file every few ms
+                    owner_.settledInstrument_.store(wanted);   // an offline render must not wait for it
                 }
             }
         }
@@ -77,9 +87,11 @@ juce::AudioProcessorValueTreeState::ParameterLayout RosinProcessor::createLayout
         const auto& info = paramInfo(i);
         const juce::String id(info.id.data(), info.id.size()), name(info.name.data(), info.name.size());
         if (info.steps > 0) {
-            const juce::StringArray choices = juce::StringArray::fromTokens(juce::String(info.choices.data(), info.choices.size()), "|", "");
-            layout.add(std::make_unique<juce::AudioParameterChoice>(juce::ParameterID{id, 1}, name, choices,
-                                                                     juce::roundToInt(info.def - info.min)));
+            juce::StringArray choices = juce::StringArray::fromTokens(juce::String(info.choices.data(), info.choices.size()), "|", "");
+            // Spare slots keep every choice's normalised value when one is added (Parameters.h).
+            const juce::String last = choices[choices.size() - 1];
+            while (choices.size() < info.steps) choices.add(last + " (spare " + juce::String(choices.size() + 1) + ")");
+            layout.add(std::make_unique<juce::AudioParameterChoice>(juce::ParameterID{id, 1}, name, choices, juce::roundToInt(info.def - info.min)));
             continue;
         }
         juce::NormalisableRange<float> range(info.min, info.max);
@@ -91,10 +103,8 @@ juce::AudioProcessorValueTreeState::ParameterLayout RosinProcessor::createLayout
                               .withValueFromStringFunction([](const juce::String& t) { return t.getFloatValue(); });
         layout.add(std::make_unique<juce::AudioParameterFloat>(juce::ParameterID{id, 1}, name, range, info.def, attributes));
     }
-    layout.add(std::make_unique<juce::AudioParameterChoice>(juce::ParameterID{instrumentParamId, 1}, "Instrument",
-                                                             instrumentNames(), 2));
-    layout.add(std::make_unique<juce::AudioParameterChoice>(juce::ParameterID{hidParamId, 1}, "HID controller",
-                                                             juce::StringArray{"Off", "On"}, 0));
+    layout.add(std::make_unique<juce::AudioParameterChoice>(juce::ParameterID{instrumentParamId, 1}, "Instrument", instrumentNames(), 2));
+    layout.add(std::make_unique<juce::AudioParameterChoice>(juce::ParameterID{hidParamId, 1}, "HID controller", juce::StringArray{"Off", "On"}, 0));
     return layout;
 }
 
@@ -111,17 +121,19 @@ RosinProcessor::RosinProcessor()
     hidRaw_ = state_.getRawParameterValue(hidParamId);
     hid_ = std::make_unique<hid::HidInput>(hid::makeHidapiBackend());
     pushed_.fill(std::numeric_limits<float>::quiet_NaN());
-    loadedInstrument_.store(juce::roundToInt(instrumentRaw_->load()));
+    const int index = juce::roundToInt(instrumentRaw_->load());
+    requestedInstrument_.store(index);
+    settledInstrument_.store(index);
     loader_ = std::make_unique<Loader>(*this);
     loader_->startThread();
 }
 
 RosinProcessor::~RosinProcessor()
 {
-    loader_->stopThread(2000);
+    loader_->stopThread(2000); // first: it is the retire queues' only consumer
     hid_->stop();
-    collectGarbage();
-    delete pending_.exchange(nullptr);
+    engines_.collect();
+    map_.collect();
     delete retiring_;
     delete current_;
 }
@@ -133,33 +145,46 @@ engine::ParamValues RosinProcessor::currentParams() const
     return v;
 }
 
-std::unique_ptr<engine::Synth> RosinProcessor::buildSynth(const engine::InstrumentPreset& preset, double sampleRate, int tag)
+std::unique_ptr<engine::Synth> RosinProcessor::buildSynth(const presets::InstrumentPreset& preset, double sampleRate, int tag)
 {
     auto synth = std::make_unique<engine::Synth>();
-    synth->prepare(sampleRate, preset, currentParams(), &map_);
+    synth->prepare(sampleRate, preset, currentParams());
     synth->setTag(tag);
-    synth->setViewTap(viewRing_.get()); // the window's views follow whichever engine plays
     return synth;
 }
 
-void RosinProcessor::handOver(std::unique_ptr<engine::Synth> synth)
-{
-    // A pending engine the audio thread has not taken yet never played: free it here.
-    delete pending_.exchange(synth.release(), std::memory_order_acq_rel);
-}
-
-void RosinProcessor::collectGarbage()
-{
-    engine::Synth* old = nullptr;
-    while (trash_.pop(old)) delete old;
-}
-
-void RosinProcessor::setPhysical(engine::Param p, double value)
+void RosinProcessor::setPhysical(Param p, double value)
 {
     // Host parameters hold choices as an index from 0; the engine's table counts from `min`.
     const auto& info = paramInfo(p);
     if (auto* param = state_.getParameter(juce::String(info.id.data(), info.id.size())))
         param->setValueNotifyingHost(param->convertTo0to1(static_cast<float>(info.steps > 0 ? value - info.min : value)));
+}
+
+void RosinProcessor::housekeeping()
+{
+    engines_.collect();
+    map_.collect();
+    // Host parameters that a learned controller or a keyswitch moved: the latest value of each,
+    // so the slider, automation, the saved session and the views agree with what plays.
+    std::array<float, paramCount> latest{};
+    std::array<int, paramCount> count{};
+    HostChange c;
+    while (toHost_.pop(c))
+        if (c.param >= 0 && c.param < paramCount) {
+            latest[static_cast<std::size_t>(c.param)] = c.value;
+            ++count[static_cast<std::size_t>(c.param)];
+        }
+    for (int i = 0; i < paramCount; ++i)
+        if (count[static_cast<std::size_t>(i)] > 0) {
+            setPhysical(static_cast<Param>(i), latest[static_cast<std::size_t>(i)]);
+            inFlight_[static_cast<std::size_t>(i)].fetch_sub(count[static_cast<std::size_t>(i)], std::memory_order_release);
+        }
+    Learn l;
+    while (learned_.pop(l)) {
+        const auto& info = paramInfo(l.param);
+        map_.set(l.cc, l.param, info.min, info.max, false);
+    }
 }
 
 void RosinProcessor::pollHid()
@@ -171,39 +196,14 @@ void RosinProcessor::pollHid()
 
 void RosinProcessor::loadHidMapping(const juce::String& name)
 {
-    hid_->setMapping(hid::HidMapping::fromDocument(library_.open("controllers", name.toStdString(), "rosin-hid/1")));
-}
-
-void RosinProcessor::drainHid(engine::Synth& synth) noexcept
-{
-    // Every note trigger counts; for the bow only the latest state matters.
-    hid::BowCommand c;
-    bool got = false;
-    while (hid_->queue().pop(c)) {
-        got = true;
-        for (int off : {static_cast<int>(c.noteOff), static_cast<int>(c.noteOff2)})
-            if (off >= 0) {
-                const std::uint8_t msg[3] = {0x80, static_cast<std::uint8_t>(off), 0};
-                synth.handleMidi(msg, 3);
-            }
-        for (int on : {static_cast<int>(c.noteOn), static_cast<int>(c.noteOn2)})
-            if (on >= 0) {
-                const std::uint8_t msg[3] = {0x90, static_cast<std::uint8_t>(on), 100};
-                synth.handleMidi(msg, 3);
-            }
-        external_ = {true, c.engaged, c.force, c.speed, c.beta, c.string};
-    }
-    if (!hid_->running() && external_.active) { // switched off: the parameters play again
-        external_ = {};
-        got = true;
-    }
-    if (got) synth.setExternalBow(external_);
+    hid_->setMapping(hid::HidMapping::fromDocument(library_.open("controllers", name.toStdString(), "")));
 }
 
 void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults)
 {
     const std::lock_guard<std::mutex> lock(loadMutex_);
     const int index = instrumentNames().indexOf(name);
+    if (index >= 0) requestedInstrument_.store(index);
     const auto preset = presets::loadInstrument(library_, name.toStdString());
     if (applyDefaults) {
         setPhysical(Param::BowForce, preset.bowForce);
@@ -212,18 +212,13 @@ void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults
         setPhysical(Param::AttackAccel, preset.attackAccel);
         setPhysical(Param::RosinTg, preset.rosinTg);
     }
-    if (index >= 0) {
+    if (index >= 0)
         if (auto* param = state_.getParameter(instrumentParamId))
-            if (juce::roundToInt(instrumentRaw_->load()) != index)
-                param->setValueNotifyingHost(param->convertTo0to1(static_cast<float>(index)));
-        loadedInstrument_.store(index);
-    }
+            if (juce::roundToInt(instrumentRaw_->load()) != index) param->setValueNotifyingHost(param->convertTo0to1(static_cast<float>(index)));
     instrumentName_ = name;
     const double rate = sampleRate_.load();
-    if (rate > 0.0) {
-        collectGarbage();
-        handOver(buildSynth(preset, rate, index));
-    }
+    if (rate > 0.0) engines_.publish(buildSynth(preset, rate, index), index);
+    if (index >= 0) settledInstrument_.store(index);
 }
 
 void RosinProcessor::loadExciter(const juce::String& name)
@@ -250,61 +245,206 @@ juce::String RosinProcessor::currentInstrument() const
     return instrumentName_;
 }
 
+juce::String RosinProcessor::lastStateProblem() const
+{
+    const std::lock_guard<std::mutex> lock(loadMutex_);
+    return stateProblem_;
+}
+
 void RosinProcessor::prepareToPlay(double sampleRate, int maximumExpectedSamplesPerBlock)
 {
-    // The host guarantees the audio thread is stopped here: install directly.
+    // The host guarantees the audio thread is stopped here: this thread stands in for it.
     const std::lock_guard<std::mutex> lock(loadMutex_);
-    delete pending_.exchange(nullptr);
-    collectGarbage();
+    fadeLength_ = std::max(1, juce::roundToInt(swapFadeSeconds * sampleRate));
+    fadeBuffer_.setSize(2, std::max(maximumExpectedSamplesPerBlock, fadeLength_));
+    const int index = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(instrumentRaw_->load()));
+    // A pending engine never played: it is retired (the housekeeping thread frees it).
+    if (engine::Synth* pending = engines_.takePending()) {
+        if (!engines_.retire(pending)) delete pending; // the queue is full: nobody else can hold it now
+    }
     delete retiring_;
     retiring_ = nullptr;
-    delete current_;
-    current_ = nullptr;
-    const int index = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(instrumentRaw_->load()));
-    instrumentName_ = instrumentNames()[index];
-    try {
-        const auto preset = presets::loadInstrument(library_, instrumentName_.toStdString());
-        current_ = buildSynth(preset, sampleRate, index).release();
-    } catch (const std::exception& e) {
-        DBG("Rosin: " << e.what()); // no engine: processBlock outputs silence
+    retiringLeft_ = 0;
+    const bool keep = current_ != nullptr && current_->sampleRate() == sampleRate && current_->tag() == index;
+    if (!keep) {
+        delete current_;
+        current_ = nullptr;
+        instrumentName_ = instrumentNames()[index];
+        try {
+            current_ = buildSynth(presets::loadInstrument(library_, instrumentName_.toStdString()), sampleRate, index).release();
+        } catch (const std::exception& e) {
+            DBG("Rosin: " << e.what()); // no engine: processBlock outputs silence
+        }
     }
-    loadedInstrument_.store(index);
+    if (current_) {
+        current_->attach(&performance_);
+        current_->setViewTap(viewRing_.get());
+        if (!keep) current_->resumeHeldNotes();
+    }
+    requestedInstrument_.store(index);
+    settledInstrument_.store(index);
     installedInstrument_ = index;
     sampleRate_.store(sampleRate);
     pushed_.fill(std::numeric_limits<float>::quiet_NaN());
-    fadeBuffer_.setSize(2, std::max(maximumExpectedSamplesPerBlock, fadeSamples));
+    lastBlockStart_ = -1.0;
 }
 
-void RosinProcessor::releaseResources() {}
+void RosinProcessor::releaseResources()
+{
+    // The stream stopped (the audio thread with it): nothing sounds or is held any more. The MPE
+    // zones and bend ranges stay (a controller sends them once); the engine stays built.
+    performance_.stop();
+    if (current_) current_->reset();
+    delete retiring_;
+    retiring_ = nullptr;
+    retiringLeft_ = 0;
+}
 
 bool RosinProcessor::isBusesLayoutSupported(const BusesLayout& layouts) const
 {
-    return layouts.getMainOutputChannelSet() == juce::AudioChannelSet::stereo();
+    const auto out = layouts.getMainOutputChannelSet();
+    return out == juce::AudioChannelSet::stereo() || out == juce::AudioChannelSet::mono();
 }
 
-void RosinProcessor::renderSynth(engine::Synth& synth, juce::AudioBuffer<float>& buffer, const juce::MidiBuffer* midi,
-                                 bool pushParams) noexcept
+void RosinProcessor::swapEngine() noexcept
 {
-    if (pushParams)
-        for (int i = 0; i < paramCount; ++i) {
-            const float v = raw_[static_cast<std::size_t>(i)]->load(std::memory_order_relaxed);
-            if (v != pushed_[static_cast<std::size_t>(i)]) {
-                synth.setParameter(i, engineValue(i, v));
-                pushed_[static_cast<std::size_t>(i)] = v;
+    // The old engine needs a slot in the retire queue before a new one comes in.
+    if (retiring_ != nullptr && retiringLeft_ <= 0 && engines_.retire(retiring_)) retiring_ = nullptr;
+    if (retiring_ != nullptr || !engines_.hasPending()) return;
+    engine::Synth* next = engines_.takePending();
+    if (next == nullptr) return;
+    if (next->sampleRate() != sampleRate_.load(std::memory_order_relaxed)) { // built for a rate that has since changed
+        if (!engines_.retire(next)) retiring_ = next, retiringLeft_ = 0;
+        return;
+    }
+    if (current_) {
+        retiring_ = current_;
+        retiring_->setViewTap(nullptr); // the views follow the new engine only
+        retiring_->releaseAll();
+        retiringLeft_ = fadeLength_;
+    }
+    current_ = next;
+    current_->attach(&performance_);
+    current_->setViewTap(viewRing_.get());
+    pushParameters(*current_, true);
+    current_->resumeHeldNotes(); // the player still holds them: they sound on the new instrument
+    installedInstrument_ = next->tag();
+}
+
+void RosinProcessor::pushParameters(engine::Synth& synth, bool all) noexcept
+{
+    for (int i = 0; i < paramCount; ++i) {
+        const float v = raw_[static_cast<std::size_t>(i)]->load(std::memory_order_relaxed);
+        // A learned controller already moved the engine; its host parameter catches up.
+        if (!all && inFlight_[static_cast<std::size_t>(i)].load(std::memory_order_acquire) > 0) continue;
+        if (all || v != pushed_[static_cast<std::size_t>(i)]) {
+            synth.setParameter(i, engineValue(i, v));
+            pushed_[static_cast<std::size_t>(i)] = v;
+        }
+    }
+}
+
+void RosinProcessor::addEvent(const ControlEvent& e) noexcept
+{
+    if (eventCount_ >= maxBlockEvents) {
+        ++droppedEvents_;
+        return;
+    }
+    // Insertion keeps the block's events in frame order (sources arrive each in its own order).
+    int at = eventCount_++;
+    while (at > 0 && events_[static_cast<std::size_t>(at - 1)].frame > e.frame) {
+        events_[static_cast<std::size_t>(at)] = events_[static_cast<std::size_t>(at - 1)];
+        --at;
+    }
+    events_[static_cast<std::size_t>(at)] = e;
+}
+
+void RosinProcessor::hidEvents(int numSamples) noexcept
+{
+    // An event read at time t lands where t falls in the span of the previous block: one block of
+    // constant latency, and the timing between events is kept.
+    const double fs = sampleRate_.load(std::memory_order_relaxed);
+    hid::Event h;
+    while (hid_->queue().pop(h)) {
+        int frame = 0;
+        if (lastBlockStart_ > 0.0 && fs > 0.0)
+            frame = juce::jlimit(0, numSamples - 1, static_cast<int>(std::floor((h.seconds - lastBlockStart_) * fs)));
+        ControlEvent e;
+        e.frame = frame;
+        e.channel = 0;
+        switch (h.kind) {
+        case hid::Event::Kind::Bow:
+            for (const auto& [kind, value] : {std::pair{Control::Force, h.force}, std::pair{Control::DirectSpeed, h.speed},
+                                              std::pair{Control::Position, h.position}, std::pair{Control::StringChoice, static_cast<float>(h.string)},
+                                              std::pair{Control::Engage, h.engaged ? 1.0f : 0.0f}}) {
+                e.kind = kind;
+                e.value = value;
+                addEvent(e);
             }
+            break;
+        case hid::Event::Kind::NoteOn:
+        case hid::Event::Kind::NoteOff:
+            e.kind = h.kind == hid::Event::Kind::NoteOn ? Control::NoteOn : Control::NoteOff;
+            e.note = h.note;
+            e.value = 100.0f / 127.0f;
+            addEvent(e);
+            break;
+        case hid::Event::Kind::Released:
+            e.kind = Control::DirectRelease;
+            addEvent(e);
+            break;
         }
-    const int n = buffer.getNumSamples();
-    float* left = buffer.getWritePointer(0);
-    float* right = buffer.getWritePointer(1);
-    int pos = 0;
-    if (midi)
-        for (const auto meta : *midi) {
-            const int at = juce::jlimit(pos, n, meta.samplePosition);
-            synth.render(left + pos, right + pos, at - pos);
-            pos = at;
-            synth.handleMidi(meta.data, meta.numBytes);
+    }
+}
+
+void RosinProcessor::gatherEvents(const juce::MidiBuffer& midi, int numSamples) noexcept
+{
+    eventCount_ = 0;
+    const engine::ControllerTable& table = map_.acquire();
+    static const engine::ParamValues defaults = engine::defaultParams();
+    const engine::ParamValues& params = current_ ? current_->parameters() : defaults;
+    ControlEvent out[engine::MidiDecoder::maxEvents];
+    auto decode = [&](const std::uint8_t* data, int size, int frame) {
+        const int n = decoder_.decode(data, size, frame, performance_, params, &table, map_.learning(), out);
+        for (int k = 0; k < n; ++k) {
+            if (out[k].kind == Control::Learned) {
+                if (map_.claimLearn() >= 0) learned_.push({out[k].note, out[k].index});
+                continue;
+            }
+            addEvent(out[k]);
         }
-    synth.render(left + pos, right + pos, n - pos);
+    };
+    UiMidi m;
+    while (uiMidi_.pop(m)) decode(m.bytes.data(), m.size, 0);
+    for (const auto meta : midi) decode(meta.data, meta.numBytes, juce::jlimit(0, std::max(0, numSamples - 1), meta.samplePosition));
+}
+
+void RosinProcessor::handle(engine::Synth& synth, const ControlEvent& e) noexcept
+{
+    synth.apply(e);
+    if (e.kind == Control::Parameter && e.index >= 0 && e.index < paramCount) {
+        // The host parameter follows (the housekeeping thread moves it); until then the
+        // parameter push leaves the engine's value alone.
+        inFlight_[static_cast<std::size_t>(e.index)].fetch_add(1, std::memory_order_acq_rel);
+        if (!toHost_.push({e.index, synth.parameter(e.index)})) inFlight_[static_cast<std::size_t>(e.index)].fetch_sub(1, std::memory_order_acq_rel);
+    }
+}
+
+void RosinProcessor::renderCurrent(float* left, float* right, int from, int to) noexcept
+{
+    if (right != nullptr) {
+        current_->render(left + from, right + from, to - from);
+        return;
+    }
+    // A mono bus gets both channels' mix, rendered through the fade buffer in pieces of its size.
+    float* l = fadeBuffer_.getWritePointer(0);
+    float* r = fadeBuffer_.getWritePointer(1);
+    for (int start = from; start < to;) {
+        const int len = std::min(to - start, fadeBuffer_.getNumSamples());
+        current_->render(l, r, len);
+        for (int i = 0; i < len; ++i) left[start + i] = 0.5f * (l[i] + r[i]);
+        start += len;
+    }
 }
 
 void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBuffer& midi)
@@ -312,67 +452,60 @@ void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBu
     if (rosin_audit_scope) rosin_audit_scope(1);
     juce::ScopedNoDenormals noDenormals;
     const int n = buffer.getNumSamples();
-    for (int ch = 2; ch < buffer.getNumChannels(); ++ch) buffer.clear(ch, 0, n);
+    const double blockStart = steadySeconds();
 
     // Offline (a bounce, the headless host) an instrument change must land on this block, not
-    // whenever the loader gets to it: wait for the loader without locking or allocating. Live,
-    // the old instrument plays on until the new one is ready.
+    // whenever the loader gets to it: wait until the loader has settled it (built, or failed),
+    // without locking or allocating. Live, the old instrument plays on until the new one is ready.
     const int wanted = juce::roundToInt(instrumentRaw_->load(std::memory_order_relaxed));
     if (isNonRealtime() && wanted != installedInstrument_ && sampleRate_.load() > 0.0) {
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-        for (;;) {
-            const engine::Synth* p = pending_.load(std::memory_order_acquire);
-            if ((p != nullptr && p->tag() == wanted) || std::chrono::steady_clock::now() >= deadline) break;
+        while (settledInstrument_.load(std::memory_order_acquire) != wanted && std::chrono::steady_clock::now() < deadline)
             std::this_thread::yield();
-        }
     }
-    if (engine::Synth* next = pending_.load(std::memory_order_acquire)) {
-        // Room to retire the current engine? (The loader empties the queue every 20 ms.)
-        bool room = true;
-        if (retiring_ != nullptr) {
-            room = trash_.push(retiring_);
-            if (room) retiring_ = nullptr;
-        }
-        if (room && pending_.compare_exchange_strong(next, nullptr, std::memory_order_acq_rel)) {
-            if (current_) {
-                retiring_ = current_;
-                retiring_->setViewTap(nullptr); // the views follow the new engine only
-                retiring_->releaseAll();
-                retiringLeft_ = fadeSamples;
-            }
-            current_ = next;
-            current_->setExternalBow(external_);
-            installedInstrument_ = next->tag();
-            pushed_.fill(std::numeric_limits<float>::quiet_NaN());
-        }
-    }
+    swapEngine();
 
-    if (current_ == nullptr || buffer.getNumChannels() < 2) {
+    float* left = buffer.getWritePointer(0);
+    float* right = buffer.getNumChannels() > 1 ? buffer.getWritePointer(1) : nullptr;
+    for (int ch = 2; ch < buffer.getNumChannels(); ++ch) buffer.clear(ch, 0, n);
+    gatherEvents(midi, n);
+    hidEvents(n);
+    if (current_ == nullptr || fadeBuffer_.getNumSamples() < 1) {
+        // No engine (a preset that failed to load): silence, but the player's state still follows.
+        for (int k = 0; k < eventCount_; ++k) performance_.apply(events_[static_cast<std::size_t>(k)]);
         buffer.clear();
     } else {
-        drainHid(*current_);
-        UiMidi m;
-        while (uiMidi_.pop(m)) current_->handleMidi(m.bytes.data(), m.size);
-        renderSynth(*current_, buffer, &midi, true);
+        pushParameters(*current_, false);
+        int pos = 0;
+        for (int k = 0; k < eventCount_;) {
+            const int at = std::min(n, events_[static_cast<std::size_t>(k)].frame);
+            renderCurrent(left, right, pos, at);
+            pos = std::max(pos, at);
+            for (; k < eventCount_ && events_[static_cast<std::size_t>(k)].frame <= pos; ++k) handle(*current_, events_[static_cast<std::size_t>(k)]);
+        }
+        renderCurrent(left, right, pos, n);
         activeVoices_.store(current_->activeVoiceCount(), std::memory_order_relaxed);
     }
 
-    if (retiring_ != nullptr && retiringLeft_ > 0 && fadeBuffer_.getNumSamples() > 0) {
-        // The old engine fades out (linearly, fadeSamples) under the new one: no click on a swap.
+    if (retiring_ != nullptr && retiringLeft_ > 0) {
+        // The old engine fades out under the new one, linearly over swapFadeSeconds.
         const int m = std::min({n, retiringLeft_, fadeBuffer_.getNumSamples()});
         float* l = fadeBuffer_.getWritePointer(0);
         float* r = fadeBuffer_.getWritePointer(1);
         retiring_->render(l, r, m);
         for (int i = 0; i < m; ++i) {
-            const float g = static_cast<float>(retiringLeft_ - i) / static_cast<float>(fadeSamples);
-            if (buffer.getNumChannels() > 1) {
-                buffer.addSample(0, i, g * l[i]);
-                buffer.addSample(1, i, g * r[i]);
+            const float g = static_cast<float>(retiringLeft_ - i) / static_cast<float>(fadeLength_);
+            if (right) {
+                left[i] += g * l[i];
+                right[i] += g * r[i];
+            } else {
+                left[i] += g * 0.5f * (l[i] + r[i]);
             }
         }
         retiringLeft_ -= m;
     }
-    if (retiring_ != nullptr && retiringLeft_ <= 0 && trash_.push(retiring_)) retiring_ = nullptr;
+    if (retiring_ != nullptr && retiringLeft_ <= 0 && engines_.retire(retiring_)) retiring_ = nullptr;
+    lastBlockStart_ = blockStart;
 
     if (rosin_audit_scope) rosin_audit_scope(0);
 }
@@ -381,7 +514,7 @@ void RosinProcessor::getStateInformation(juce::MemoryBlock& destData)
 {
     auto tree = state_.copyState();
     std::unique_ptr<juce::XmlElement> xml(tree.createXml());
-    xml->setAttribute("format", "rosin-state/1");
+    xml->setAttribute("format", "rosin-state/" + juce::String(stateVersion));
     auto* maps = xml->createNewChildElement("Mappings");
     for (const auto& e : map_.entries()) {
         auto* m = maps->createNewChildElement("Map");
@@ -401,7 +534,17 @@ void RosinProcessor::getStateInformation(juce::MemoryBlock& destData)
 void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
 {
     std::unique_ptr<juce::XmlElement> xml(getXmlFromBinary(data, sizeInBytes));
-    if (xml == nullptr || !xml->hasTagName(state_.state.getType())) return; // not ours: keep the current state
+    if (xml == nullptr || !xml->hasTagName(state_.state.getType())) { // not ours: keep the current state
+        const std::lock_guard<std::mutex> lock(loadMutex_);
+        stateProblem_ = "the state is not a Rosin state: the current settings are kept";
+        return;
+    }
+    if (const juce::String problem = state::migrate(*xml, stateVersion); problem.isNotEmpty()) {
+        DBG("Rosin: " << problem);
+        const std::lock_guard<std::mutex> lock(loadMutex_);
+        stateProblem_ = problem;
+        return;
+    }
     std::vector<engine::MappingEntry> entries;
     if (auto* maps = xml->getChildByName("Mappings")) {
         for (auto* m : maps->getChildIterator()) {
@@ -411,28 +554,39 @@ void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
             e.min = static_cast<float>(m->getDoubleAttribute("min"));
             e.max = static_cast<float>(m->getDoubleAttribute("max"));
             e.invert = m->getBoolAttribute("invert");
-            if (e.cc >= 0 && e.cc < engine::ControllerMap::numControllers && e.param >= 0) entries.push_back(e);
+            if (e.cc >= 0 && e.cc < engine::ControllerMap::numControllers && e.param >= 0 && std::isfinite(e.min) && std::isfinite(e.max))
+                entries.push_back(e);
         }
         xml->removeChildElement(maps, true);
     }
+    juce::String problems;
     if (auto* hidXml = xml->getChildByName("Hid")) {
         for (auto* m : hidXml->getChildIterator()) {
             try {
                 hid_->setMapping(hid::HidMapping::fromJson(m->getAllSubText().toStdString(), "saved state"));
             } catch (const std::exception& e) {
-                DBG("Rosin: " << e.what()); // keep the default map for that device
+                problems += juce::String(e.what()) + "; "; // keep the default map for that device
             }
         }
         xml->removeChildElement(hidXml, true);
     }
     xml->removeAttribute("format");
+    const int before = juce::roundToInt(instrumentRaw_->load());
     state_.replaceState(juce::ValueTree::fromXml(*xml));
     map_.assign(entries);
+    {
+        const std::lock_guard<std::mutex> lock(loadMutex_);
+        stateProblem_ = problems;
+    }
+    // The same instrument keeps its engine (and what it is playing): the parameters reach it
+    // through the next block's push. Another instrument is built and swapped in.
     const int index = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(instrumentRaw_->load()));
+    if (index == before && requestedInstrument_.load() == index) return;
     try {
         loadInstrument(instrumentNames()[index], false);
     } catch (const std::exception& e) {
         DBG("Rosin: " << e.what());
+        settledInstrument_.store(index);
     }
 }
 

@@ -1,10 +1,16 @@
-// The JUCE AudioProcessor: host parameters, MIDI, state and presets around engine::Synth.
+// The JUCE AudioProcessor: host parameters, the parameter layer's sources (MIDI, the window's
+// keyboard, HID), state and presets around engine::Synth.
 //
-// Threads. The audio thread owns the current Synth. A new Synth (other instrument or rate)
-// is built off the audio thread and handed over through one atomic pointer; the audio thread
-// swaps it in at the top of a block, fades the old one out over a few milliseconds and gives
-// it back through an SPSC queue, to be freed by the loader thread. Parameters are the host's
-// atomics; MIDI-learn slots are single-word atomics (engine::ControllerMap).
+// Threads and the only channels between them:
+// - The audio thread owns the playing Synth, the Performance (what the player holds, zones,
+//   pedal: it outlives engines) and the MIDI decoder. A new Synth (another instrument or rate)
+//   is built off the audio thread and handed over with rt::Handoff; the audio thread swaps it in
+//   at the top of a block, fades the old one out and retires it.
+// - The housekeeping thread ("loader") builds engines when the instrument parameter moves, frees
+//   what the audio thread retired (the only consumer of the retire queues), moves host
+//   parameters for learned controllers and keyswitches, and records completed MIDI-learns.
+// - SPSC queues: window keyboard -> audio; audio -> housekeeping (parameter changes, learns);
+//   HID thread -> audio (events).
 #pragma once
 #include <juce_audio_processors/juce_audio_processors.h>
 #include <juce_audio_utils/juce_audio_utils.h>
@@ -14,12 +20,15 @@
 #include <memory>
 #include <mutex>
 
-#include "rosin/presets/Library.h"
-#include "rosin/rt/SpscQueue.h"
 #include "rosin/engine/ControllerMap.h"
+#include "rosin/engine/MidiDecoder.h"
+#include "rosin/engine/Performance.h"
 #include "rosin/engine/Synth.h"
 #include "rosin/engine/ViewTap.h"
 #include "rosin/hid/HidInput.h"
+#include "rosin/presets/Library.h"
+#include "rosin/rt/Handoff.h"
+#include "rosin/rt/SpscQueue.h"
 
 namespace rosin::plugin {
 
@@ -27,6 +36,8 @@ class RosinProcessor : public juce::AudioProcessor {
 public:
     static constexpr const char* instrumentParamId = "instrument";
     static constexpr const char* hidParamId = "hid_input";
+    /// The state's version: written on save, checked on load (older ones are migrated).
+    static constexpr int stateVersion = 2;
     static const juce::StringArray& instrumentNames();
 
     RosinProcessor();
@@ -55,14 +66,16 @@ public:
 
     void getStateInformation(juce::MemoryBlock& destData) override;
     void setStateInformation(const void* data, int sizeInBytes) override;
+    /// The last state that could not be loaded, in words ("" when the last one loaded).
+    juce::String lastStateProblem() const;
 
     /// [any thread but audio] Load an instrument preset by name; applyDefaults also sets the
-    /// bow parameters and rosin the preset suggests. Throws std::runtime_error on a bad file.
+    /// bow parameters and rosin the preset suggests. Throws presets::PresetError on a bad file.
     void loadInstrument(const juce::String& name, bool applyDefaults);
     void loadExciter(const juce::String& name);
     void loadMapping(const juce::String& name);
 
-    /// [any thread but audio] A controller map from presets/controllers (rosin-hid/1).
+    /// [any thread but audio] A controller map from the presets' controllers (rosin-hid/2 or 1).
     void loadHidMapping(const juce::String& name);
     /// The HID controller input (its thread starts when the hid_input parameter is on).
     hid::HidInput& hidInput() noexcept { return *hid_; }
@@ -84,31 +97,49 @@ public:
 
 private:
     class Loader;
+    struct HostChange {
+        int param = -1;
+        float value = 0.0f; ///< engine units
+    };
+    struct Learn {
+        int cc = -1, param = -1;
+    };
+
     static juce::AudioProcessorValueTreeState::ParameterLayout createLayout();
-    std::unique_ptr<engine::Synth> buildSynth(const engine::InstrumentPreset& preset, double sampleRate, int tag);
-    void handOver(std::unique_ptr<engine::Synth> synth);
-    void collectGarbage();
+    std::unique_ptr<engine::Synth> buildSynth(const presets::InstrumentPreset& preset, double sampleRate, int tag);
     void setPhysical(engine::Param p, double value); ///< [not audio] a parameter by its value in the engine's units
-    void pollHid(); ///< [loader thread] start or stop the HID input with its parameter
-    void drainHid(engine::Synth& synth) noexcept;
-    void renderSynth(engine::Synth& synth, juce::AudioBuffer<float>& buffer, const juce::MidiBuffer* midi,
-                     bool pushParams) noexcept;
+    void housekeeping(); ///< [loader thread] free retired objects, move host parameters, record learns
+    void pollHid();      ///< [loader thread] start or stop the HID input with its parameter
+    void swapEngine() noexcept;
+    void gatherEvents(const juce::MidiBuffer& midi, int numSamples) noexcept;
+    void hidEvents(int numSamples) noexcept;
+    void renderCurrent(float* left, float* right, int from, int to) noexcept;
+    void addEvent(const engine::ControlEvent& e) noexcept;
+    void handle(engine::Synth& synth, const engine::ControlEvent& e) noexcept;
+    void pushParameters(engine::Synth& synth, bool all) noexcept;
 
     juce::AudioProcessorValueTreeState state_;
+    const presets::Library library_ = presets::Library::standard(); ///< factory set + user folders, fixed at construction
     engine::ControllerMap map_;
     std::array<std::atomic<float>*, engine::paramCount> raw_{};
     std::array<float, engine::paramCount> pushed_{};
     std::atomic<float>* instrumentRaw_ = nullptr;
     std::atomic<float>* hidRaw_ = nullptr;
     std::unique_ptr<hid::HidInput> hid_;
-    engine::ExternalBow external_; ///< [audio thread] the controller's bow, re-applied after an engine swap
 
     // Audio-thread owned.
     engine::Synth* current_ = nullptr;
     engine::Synth* retiring_ = nullptr;
-    int retiringLeft_ = 0;
+    int retiringLeft_ = 0, fadeLength_ = 480;
     juce::AudioBuffer<float> fadeBuffer_;
-    static constexpr int fadeSamples = 512;
+    engine::Performance performance_;
+    engine::MidiDecoder decoder_;
+    int installedInstrument_ = -1;
+    double lastBlockStart_ = -1.0;           ///< steady-clock seconds: HID events are placed against it
+    static constexpr int maxBlockEvents = 4096;
+    std::array<engine::ControlEvent, maxBlockEvents> events_{};
+    int eventCount_ = 0;
+    std::uint64_t droppedEvents_ = 0;
 
     // Crossing threads.
     std::unique_ptr<engine::ViewRing> viewRing_ = std::make_unique<engine::ViewRing>(1u << 15);
@@ -117,17 +148,19 @@ private:
         int size = 0;
     };
     rt::SpscQueue<UiMidi, 256> uiMidi_;
-    std::atomic<engine::Synth*> pending_{nullptr};
-    rt::SpscQueue<engine::Synth*, 16> trash_;
+    rt::Handoff<engine::Synth> engines_;
+    rt::SpscQueue<HostChange, 1024> toHost_;        ///< audio -> housekeeping
+    rt::SpscQueue<Learn, 64> learned_;              ///< audio -> housekeeping
+    std::array<std::atomic<int>, engine::paramCount> inFlight_{}; ///< host changes queued, not yet made
     std::atomic<double> sampleRate_{0.0};
-    std::atomic<int> loadedInstrument_{-1};   ///< index of the instrument whose Synth is installed or pending
-    int installedInstrument_ = -1;            ///< [audio thread] index of current_'s instrument
+    std::atomic<int> requestedInstrument_{-1}; ///< [loader] the instrument it last started to build
+    std::atomic<int> settledInstrument_{-1};   ///< the instrument whose build finished (an engine, or a failure)
     std::atomic<int> activeVoices_{0};
 
     mutable std::mutex loadMutex_; ///< serialises loaders (never taken on the audio thread)
     juce::String instrumentName_{"cello"};
+    juce::String stateProblem_;
     std::unique_ptr<Loader> loader_;
-    const presets::Library library_ = presets::Library::standard(); ///< factory set + user folders, fixed at construction
 
     JUCE_DECLARE_NON_COPYABLE_WITH_LEAK_DETECTOR(RosinProcessor)
 };

@@ -192,6 +192,72 @@ TEST(EngineDeterminism, BlockSizeDoesNotChangeOneBit)
     }
 }
 
+// The instrument on the model's fast path: each voice runs its string a control interval at a
+// time through BowedString::processBlock. The reference runs it one sample at a time.
+TEST(EngineFastPath, BlockPathEqualsTheSampleBySamplePath)
+{
+    const std::vector<Event> events{on(0, 50, 90), cc(3000, 74, 90), bend(4100, 9000), on(7001, 57, 60), cc(8000, 1, 100),
+                                    pressure(9000, 100, 0), on(12000, 69, 110), off(20000, 50), off(26000, 57), off(27000, 69)};
+    for (const float model : {1.0f, 0.0f, 2.0f}) { // thermal (the fast loop), friction curve, enhanced
+        ParamValues p = defaultParams();
+        p[static_cast<int>(Param::FrictionModel)] = model;
+        auto fast = makeSynth("violin", 48000.0, p), reference = makeSynth("violin", 48000.0, p);
+        reference->setPerSample(true);
+        const auto a = render(*fast, 30000, events, 256), b = render(*reference, 30000, events, 256);
+        ASSERT_EQ(a.first.size(), b.first.size());
+        double worst = 0.0, peak = 0.0;
+        for (std::size_t i = 0; i < a.first.size(); ++i) {
+            worst = std::max(worst, static_cast<double>(std::abs(a.first[i] - b.first[i])));
+            peak = std::max(peak, static_cast<double>(std::abs(b.first[i])));
+        }
+        EXPECT_GT(peak, 1e-3) << "model " << model;
+        EXPECT_LE(worst, 1e-6 * peak) << "model " << model; // float rounding at most (the loops run the same operations)
+    }
+}
+
+TEST(EngineVoices, AStolenNoteFadesOutInsteadOfClicking)
+{
+    auto s = makeSynth("cello");
+    std::vector<Event> notes;
+    for (int k = 0; k < Synth::maxVoices; ++k) notes.push_back(on(k * 100, 36 + 2 * k, 100));
+    const auto before = mono(render(*s, 24000, notes));
+    ASSERT_EQ(s->activeVoiceCount(), Synth::maxVoices);
+    const int oldestNote = 36;
+    // The 17th note takes the oldest note's place; that one fades in its own slot (a spare).
+    auto after = mono(render(*s, 48, {on(0, 80, 100)}));
+    EXPECT_EQ(s->activeVoiceCount(), Synth::maxVoices + 1); // 1 ms in: still fading
+    const auto rest = mono(render(*s, 432, {}));
+    after.insert(after.end(), rest.begin(), rest.end());
+    EXPECT_EQ(s->activeVoiceCount(), Synth::maxVoices); // 10 ms later it is gone
+    bool oldestSounding = false;
+    for (int i = 0; i < Synth::voiceSlots; ++i) oldestSounding = oldestSounding || (s->voiceInfo(i).active && s->voiceInfo(i).note == oldestNote);
+    EXPECT_FALSE(oldestSounding);
+    // No step larger than the music's own in the 10 ms after the steal.
+    double stepBefore = 0.0, stepAfter = std::abs(static_cast<double>(after[0]) - before.back());
+    for (std::size_t i = before.size() - 4800; i < before.size(); ++i) stepBefore = std::max(stepBefore, std::abs(static_cast<double>(before[i]) - before[i - 1]));
+    for (std::size_t i = 1; i < after.size(); ++i) stepAfter = std::max(stepAfter, std::abs(static_cast<double>(after[i]) - after[i - 1]));
+    EXPECT_LT(stepAfter, 1.5 * stepBefore);
+}
+
+TEST(EngineVoices, ANonFiniteVoiceIsFreedAndTheOthersPlayOn)
+{
+    auto s = makeSynth("cello");
+    const int fs = 48000;
+    render(*s, fs / 4, {on(0, 50), on(0, 57)});
+    ASSERT_EQ(s->activeVoiceCount(), 2);
+    int poisoned = -1;
+    for (int i = 0; i < Synth::voiceSlots && poisoned < 0; ++i)
+        if (s->voiceInfo(i).active && s->voiceInfo(i).note == 57) poisoned = i;
+    ASSERT_GE(poisoned, 0);
+    // A fault inside the model (never reachable from parameters): NaN in the string's lines.
+    s->voice(poisoned).stringModel(s->voiceInfo(poisoned).stringIndex).processForce(std::nanf(""));
+    const auto out = mono(render(*s, fs / 4, {}));
+    for (float x : out) ASSERT_TRUE(std::isfinite(x));
+    EXPECT_EQ(s->activeVoiceCount(), 1);
+    EXPECT_GT(test::rms(out, fs / 8, fs / 4), 1e-2); // the D still sounds (the old guard silenced the mix)
+    EXPECT_LT(std::abs(test::cents(test::pitchHz(out, fs, fs / 16, fs / 4), test::midiToHz(50))), 10.0);
+}
+
 TEST(EngineMidi, FourteenBitControllersReachTheBowForce)
 {
     auto s = makeSynth("cello");
@@ -332,38 +398,73 @@ TEST(EngineRobustness, FrictionModelSwitchMidNoteKeepsTheNoteSounding)
     }
 }
 
-TEST(EngineExternalBow, AControllerBowReplacesTheNominalAndMayReverse)
+namespace {
+ControlEvent control(Control kind, float value, int channel = 0, int note = -1)
+{
+    ControlEvent e;
+    e.kind = kind;
+    e.value = value;
+    e.channel = static_cast<std::int8_t>(channel);
+    e.note = static_cast<std::int8_t>(note);
+    return e;
+}
+} // namespace
+
+// A controller's hand on the bow (what HID sends): the same normalised controls as MIDI, mapped
+// with the same nominal parameters and the same per-string scaling; the speed is signed.
+TEST(EngineDirectBow, AControllersHandHoldsTheBowThroughTheSameMapping)
 {
     auto s = makeSynth("cello");
-    ExternalBow bow;
-    bow.active = bow.engaged = true;
-    bow.force = 1.2f;
-    bow.speed = 0.2f;
-    bow.beta = 0.12f;
-    bow.string = 1; // G string: D3 played there, not on the open D
-    s->setExternalBow(bow);
+    const ParamValues& p = s->parameters();
+    const double nominalForce = p[static_cast<int>(Param::BowForce)], nominalSpeed = p[static_cast<int>(Param::BowSpeed)];
+    const double nominalBeta = p[static_cast<int>(Param::BowPosition)];
+    const double gScale = stringForceScale(s->instrument(), 1);
+    ASSERT_GT(std::abs(gScale - 1.0), 0.05); // the G string is heavier than the D: the scaling shows
+    for (const auto& e : {control(Control::StringChoice, 1.0f), control(Control::Force, 0.6f), control(Control::DirectSpeed, 0.7f),
+                          control(Control::Position, 0.7f), control(Control::Engage, 1.0f)})
+        s->apply(e);
     const int fs = 48000;
     const auto down = mono(render(*s, fs / 2, {on(0, 50)}));
     VoiceInfo v = s->voiceInfo(0);
-    EXPECT_EQ(v.stringIndex, 1);
-    EXPECT_NEAR(v.force, 1.2, 1e-3);
-    EXPECT_NEAR(v.speed, 0.2, 1e-3);
-    EXPECT_NEAR(v.beta, 0.12, 1e-3);
+    EXPECT_EQ(v.stringIndex, 1); // the controller chose the G string: D3 is stopped there
+    EXPECT_NEAR(v.force, 2.0 * 0.6 * nominalForce * gScale, 1e-3);
+    EXPECT_NEAR(v.speed, 2.0 * 0.7 * nominalSpeed, 1e-3);
+    EXPECT_NEAR(v.beta, nominalBeta * std::exp2(2.0 * 0.2), 1e-3);
     EXPECT_GT(test::rms(down, fs / 4, fs / 2), 1e-2);
-    bow.speed = -0.2f; // bow change
-    s->setExternalBow(bow);
+    s->apply(control(Control::DirectSpeed, -0.7f)); // a bow change
     const auto up = mono(render(*s, fs / 2, {}));
-    EXPECT_NEAR(s->voiceInfo(0).speed, -0.2, 1e-3);
+    EXPECT_NEAR(s->voiceInfo(0).speed, -2.0 * 0.7 * nominalSpeed, 1e-3);
     EXPECT_GT(test::rms(up, fs / 4, fs / 2), 1e-2);
     EXPECT_LT(std::abs(test::cents(test::pitchHz(up, fs, fs / 4, fs / 2), test::midiToHz(50))), 10.0);
-    bow.engaged = false; // lifted: no force, the string rings down
-    s->setExternalBow(bow);
+    s->apply(control(Control::Engage, 0.0f)); // lifted: no force, the string rings down
     render(*s, fs / 10, {});
     EXPECT_NEAR(s->voiceInfo(0).force, 0.0, 1e-3);
-    bow.force = NAN;
-    bow.speed = INFINITY;
-    s->setExternalBow(bow);
-    EXPECT_TRUE(std::isfinite(s->externalBow().force) && std::isfinite(s->externalBow().speed));
+    // Absurd values reach the model clamped to its own limits, never as NaN.
+    s->apply(control(Control::Engage, 1.0f));
+    s->apply(control(Control::Force, NAN));
+    s->apply(control(Control::DirectSpeed, INFINITY));
+    const auto wild = mono(render(*s, fs / 10, {}));
+    for (float x : wild) ASSERT_TRUE(std::isfinite(x));
+    EXPECT_LE(std::abs(s->voiceInfo(0).speed), 2.0 * nominalSpeed + 1e-6);
+    // Released: the channel's virtual player bows again (the direction alternates, speed positive first).
+    s->apply(control(Control::DirectRelease, 0.0f));
+    render(*s, fs / 4, {off(0, 50), on(10, 57)});
+    EXPECT_FALSE(s->performance().channel(0).direct);
+}
+
+TEST(EngineDirectBow, MidiPressureAndAControllerReachTheSameForce)
+{
+    // The one road: CC2 at x and a controller's force at x give the same newtons on one string.
+    ParamValues p = defaultParams();
+    p[static_cast<int>(Param::AttackForce)] = 0.0f;
+    auto midi = makeSynth("cello", 48000.0, p), hid = makeSynth("cello", 48000.0, p);
+    render(*midi, 24000, {cc(0, 2, 90), on(1, 50)});
+    hid->apply(control(Control::Force, 90.0f / 127.0f));
+    hid->apply(control(Control::DirectSpeed, 0.5f));
+    hid->apply(control(Control::Engage, 1.0f));
+    render(*hid, 24000, {on(1, 50)});
+    EXPECT_NEAR(midi->voiceInfo(0).force, hid->voiceInfo(0).force, 1e-4);
+    EXPECT_NEAR(midi->voiceInfo(0).force, 2.0 * 90.0 / 127.0 * p[static_cast<int>(Param::BowForce)], 1e-3);
 }
 
 // The editor's live views: the newest note writes its physics, sample by sample, into the ring

@@ -3,6 +3,7 @@
 // descriptor, then reports of 1 length byte + data. Build and run: scripts/fuzz.sh.
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "rosin/hid/Descriptor.h"
 #include "rosin/hid/Mapping.h"
@@ -28,13 +29,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     DeviceState state;
     std::size_t at = 2 + len;
     double t = 0.0;
+    std::vector<Event> events;
     while (at < size) {
         const std::size_t n = std::min<std::size_t>(data[at], size - at - 1);
         decoder.apply(data + at + 1, n, state);
-        const BowCommand c = mapper.update(state, t += 0.001);
-        if (!(c.force >= 0.0f && c.force <= 100.0f) || !(c.beta >= 0.02f && c.beta <= 0.3f) || !(c.speed == c.speed))
-            __builtin_trap();
+        events.clear();
+        mapper.update(state, t += 0.001, events);
+        for (const Event& c : events) // normalised controls, whatever the report held
+            if (!(c.force >= 0.0f && c.force <= 1.0f) || !(c.position >= 0.0f && c.position <= 1.0f) || !(c.speed >= -1.0f && c.speed <= 1.0f))
+                __builtin_trap();
         at += 1 + n;
     }
+    events.clear();
+    mapper.release(t, events);
+    if (mapper.heldNotes() != 0 || events.empty() || events.back().kind != Event::Kind::Released) __builtin_trap();
     return 0;
 }

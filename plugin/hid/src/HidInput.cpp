@@ -21,10 +21,17 @@ HidInput::~HidInput() { stop(); }
 
 void HidInput::setMapping(const HidMapping& m)
 {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    for (auto& existing : mappings_)
-        if (existing.kind == m.kind) { existing = m; return; }
-    mappings_.push_back(m);
+    {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        bool replaced = false;
+        for (auto& existing : mappings_)
+            if (existing.kind == m.kind) {
+                existing = m;
+                replaced = true;
+            }
+        if (!replaced) mappings_.push_back(m);
+    }
+    mappingGeneration_.fetch_add(1, std::memory_order_release);
 }
 
 HidMapping HidInput::mapping(DeviceKind kind) const
@@ -33,13 +40,6 @@ HidMapping HidInput::mapping(DeviceKind kind) const
     for (const auto& m : mappings_)
         if (m.kind == kind) return m;
     return HidMapping::defaultFor(kind);
-}
-
-void HidInput::setFilter(std::uint16_t vendor, std::uint16_t product)
-{
-    const std::lock_guard<std::mutex> lock(mutex_);
-    filterVendor_ = vendor;
-    filterProduct_ = product;
 }
 
 bool HidInput::setBackend(std::unique_ptr<DeviceBackend> backend)
@@ -76,13 +76,13 @@ void HidInput::setStatus(const std::string& s)
     status_ = s;
 }
 
-bool HidInput::push(const BowCommand& c)
+bool HidInput::push(const Event& e)
 {
-    // A full queue means the audio thread is not running (no host playback): drop, the next
-    // report carries the current state anyway. Note triggers are retried briefly.
+    // A full queue means the audio thread is not running (no host playback): a bow state is
+    // dropped (the next report carries the current one); note transitions are retried briefly.
     for (int attempt = 0; attempt < 3; ++attempt) {
-        if (queue_.push(c)) return true;
-        if (c.noteOn < 0 && c.noteOff < 0) return false;
+        if (queue_.push(e)) return true;
+        if (e.kind == Event::Kind::Bow) return false;
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     return false;
@@ -98,14 +98,7 @@ void HidInput::run()
         std::unique_ptr<DeviceHandle> handle;
         DeviceInfo info;
         DeviceDecoder decoder;
-        std::uint16_t fv = 0, fp = 0;
-        {
-            const std::lock_guard<std::mutex> lock(mutex_);
-            fv = filterVendor_;
-            fp = filterProduct_;
-        }
         for (const DeviceInfo& candidate : backend_->enumerate()) {
-            if (fv != 0 && (candidate.vendor != fv || (fp != 0 && candidate.product != fp))) continue;
             std::string error;
             auto h = backend_->open(candidate, error);
             if (!h) {
@@ -115,7 +108,7 @@ void HidInput::run()
             const auto bytes = h->descriptor();
             try {
                 DeviceDecoder d(parseDescriptor(bytes), quirksFor(candidate.vendor, candidate.product));
-                if (d.kind() == DeviceKind::Other && fv == 0) continue; // keyboards, mice: not a bow
+                if (d.kind() == DeviceKind::Other) continue; // keyboards, mice: not a bow
                 decoder = std::move(d);
             } catch (const std::exception& e) {
                 lastError = candidate.name + ": " + e.what();
@@ -134,22 +127,39 @@ void HidInput::run()
         ++connections_;
         lastError.clear();
         gone.clear();
+        unsigned generation = mappingGeneration_.load(std::memory_order_acquire);
         BowMapper mapper(mapping(decoder.kind()));
         DeviceState state;
+        std::vector<Event> events;
+        auto send = [&] {
+            for (const Event& e : events) push(e);
+            events.clear();
+        };
         setStatus(info.name + " (" + kindName(decoder.kind()) + ")");
         while (!stopRequested_) {
+            if (const unsigned g = mappingGeneration_.load(std::memory_order_acquire); g != generation) {
+                generation = g; // edited in the window: applies from the next report
+                mapper.setMapping(mapping(decoder.kind()));
+            }
             const int n = handle->read(buffer.data(), buffer.size(), 10);
             if (n < 0) { // unplugged mid-note: lift the bow and end its notes
-                push(mapper.release(now()));
+                mapper.release(now(), events);
+                send();
                 gone = info.name;
                 setStatus(info.name + " unplugged");
                 break;
             }
             if (n == 0) continue;
             ++reports_;
-            if (decoder.apply(buffer.data(), static_cast<std::size_t>(n), state)) push(mapper.update(state, now()));
+            if (decoder.apply(buffer.data(), static_cast<std::size_t>(n), state)) {
+                mapper.update(state, now(), events);
+                send();
+            }
         }
-        if (stopRequested_) push(mapper.release(now()));
+        if (stopRequested_) {
+            mapper.release(now(), events);
+            send();
+        }
     }
 }
 

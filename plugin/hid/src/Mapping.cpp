@@ -182,7 +182,7 @@ HidMapping HidMapping::defaultFor(DeviceKind kind)
         // Sticks, pucks and throttles hold their position: the axis is the speed, no pen to touch.
         m.speed = Source::AxisX;
         m.speedFromMotion = false;
-        m.positionCurve = {-1.0, 1.0, 0.03, 0.25};
+        m.positionCurve = {-1.0, 1.0, 0.0, 1.0};
         m.stringSelect = Source::None;
         m.requireTip = false;
         m.tipNote = -1;
@@ -192,18 +192,18 @@ HidMapping HidMapping::defaultFor(DeviceKind kind)
     case DeviceKind::Tablet: break; // the struct defaults are the tablet (CONTROLLERS.md 5)
     case DeviceKind::Gamepad:
         m.force = Source::TriggerR;
-        m.forceCurve = {0.0, 1.0, 0.0, 2.5, 1.5, 0.03};
+        m.forceCurve = {0.0, 1.0, 0.0, 1.0, 1.5, 0.03};
         m.position = Source::AxisY;
         m.buttonNotes = {43, 50, 57, 64, -1, -1, -1, -1};
         break;
     case DeviceKind::SpaceMouse:
         m.force = Source::AxisZ;
-        m.forceCurve = {-1.0, 0.0, 0.0, 2.5, 1.5, 0.05, true}; // push down (negative Z) = more force
+        m.forceCurve = {-1.0, 0.0, 0.0, 1.0, 1.5, 0.05, true}; // push down (negative Z) = more force
         m.position = Source::AxisY;
         break;
     case DeviceKind::Joystick:
         m.force = Source::AxisY;
-        m.forceCurve = {-1.0, 1.0, 0.0, 2.5, 1.5, 0.0, true}; // pull back = more force
+        m.forceCurve = {-1.0, 1.0, 0.0, 1.0, 1.5, 0.0, true}; // pull back = more force
         m.position = Source::Slider;
         break;
     case DeviceKind::Other: m.force = Source::None; m.buttonNotes.fill(-1); break;
@@ -241,13 +241,13 @@ Curve curveFrom(const presets::Document& d, const nlohmann::json& j, const std::
 
 std::string HidMapping::toJson() const
 {
-    nlohmann::json j{{"format", "rosin-hid/1"},
+    nlohmann::json j{{"format", "rosin-hid/2"},
                      {"name", name},
                      {"device", kindName(kind)},
                      {"force", {{"source", sourceName(force)}, {"curve", curveJson(forceCurve)}}},
-                     {"speed", {{"source", sourceName(speed)}, {"from_motion", speedFromMotion}, {"scale_m", speedScale},
+                     {"speed", {{"source", sourceName(speed)}, {"from_motion", speedFromMotion}, {"scale", speedScale},
                                 {"curve", curveJson(speedCurve)}, {"smoothing_s", speedSmoothing},
-                                {"bow_change_m_s", bowChangeThreshold}}},
+                                {"bow_change", bowChangeThreshold}}},
                      {"position", {{"source", sourceName(position)}, {"curve", curveJson(positionCurve)}}},
                      {"string", {{"source", sourceName(stringSelect)}, {"curve", curveJson(stringCurve)}, {"count", strings}}},
                      {"require_tip", requireTip},
@@ -263,7 +263,9 @@ HidMapping HidMapping::fromJson(const std::string& text, const std::string& wher
 
 HidMapping HidMapping::fromDocument(const presets::Document& d)
 {
-    d.requireFormat("rosin-hid/1");
+    const std::string format = d.text(d.root(), "format", "", false, "");
+    if (format != "rosin-hid/1" && format != "rosin-hid/2") d.fail("field 'format' is '" + format + "', expected 'rosin-hid/2' (or 1)");
+    const bool v1 = format == "rosin-hid/1";
     const auto& j = d.root();
     HidMapping m;
     auto kindOf = [&](const std::string& name) {
@@ -288,15 +290,42 @@ HidMapping HidMapping::fromDocument(const presets::Document& d)
         if (s.contains("source")) src = sourceOf(d.text(s, "source", where), where);
         if (s.contains("curve")) curve = curveFrom(d, d.object(s, "curve", where), std::string(key) + ".curve", curve);
     };
+    if (v1) { // version 1's defaults, in its units, before the file's own values
+        m.forceCurve.outMin = 0.0, m.forceCurve.outMax = 2.5;
+        m.speedCurve.outMin = -0.6, m.speedCurve.outMax = 0.6;
+        m.positionCurve.outMin = 0.03, m.positionCurve.outMax = 0.25;
+    }
     section("force", m.force, m.forceCurve);
     section("speed", m.speed, m.speedCurve);
     section("position", m.position, m.positionCurve);
     section("string", m.stringSelect, m.stringCurve);
     const auto& speed = d.object(j, "speed", "", false);
     m.speedFromMotion = d.flag(speed, "from_motion", "speed: ", m.speedFromMotion);
-    m.speedScale = d.number(speed, "scale_m", "speed: ", false, m.speedScale, 1e-6, 10.0);
     m.speedSmoothing = d.number(speed, "smoothing_s", "speed: ", false, m.speedSmoothing, 0.0, 0.999);
-    m.bowChangeThreshold = d.number(speed, "bow_change_m_s", "speed: ", false, m.bowChangeThreshold, 0.0, 10.0);
+    if (v1) {
+        // Version 1 wrote newtons, m/s and beta. Its maps meant them for the instruments' default
+        // bow (1.1 N, 0.15 m/s, beta 0.0899), so they become the same bow there, normalised.
+        constexpr double forceFull = 2.0 * 1.1, speedFull = 2.0 * 0.15, betaNominal = 0.0899;
+        m.speedScale = d.number(speed, "scale_m", "speed: ", false, 0.22, 1e-6, 10.0) / speedFull;
+        m.bowChangeThreshold = d.number(speed, "bow_change_m_s", "speed: ", false, 0.02, 0.0, 10.0) / speedFull;
+        auto position = [&](double beta) { return std::clamp(0.5 + 0.5 * std::log2(std::max(beta, 1e-6) / betaNominal), 0.0, 1.0); };
+        m.forceCurve.outMin = std::clamp(m.forceCurve.outMin / forceFull, 0.0, 1.0);
+        m.forceCurve.outMax = std::clamp(m.forceCurve.outMax / forceFull, 0.0, 1.0);
+        m.speedCurve.outMin = std::clamp(m.speedCurve.outMin / speedFull, -1.0, 1.0);
+        m.speedCurve.outMax = std::clamp(m.speedCurve.outMax / speedFull, -1.0, 1.0);
+        m.positionCurve.outMin = position(m.positionCurve.outMin);
+        m.positionCurve.outMax = position(m.positionCurve.outMax);
+    } else {
+        m.speedScale = d.number(speed, "scale", "speed: ", false, m.speedScale, 1e-6, 100.0);
+        m.bowChangeThreshold = d.number(speed, "bow_change", "speed: ", false, m.bowChangeThreshold, 0.0, 1.0);
+        auto within = [&](const Curve& c, double lo, double hi, const char* what) {
+            if (c.outMin < lo || c.outMin > hi || c.outMax < lo || c.outMax > hi)
+                d.fail(std::string(what) + ".curve.out must lie within [" + nlohmann::json(lo).dump() + ", " + nlohmann::json(hi).dump() + "]");
+        };
+        within(m.forceCurve, 0.0, 1.0, "force");
+        within(m.speedCurve, -1.0, 1.0, "speed");
+        within(m.positionCurve, 0.0, 1.0, "position");
+    }
     m.strings = d.integer(d.object(j, "string", "", false), "count", "string: ", false, m.strings, 1, 5);
     m.requireTip = d.flag(j, "require_tip", "", m.requireTip);
     m.tipNote = d.integer(j, "tip_note", "", false, m.tipNote, -1, 127);
@@ -313,38 +342,6 @@ HidMapping HidMapping::fromDocument(const presets::Document& d)
     return m;
 }
 
-void Calibration::reset()
-{
-    lo_.fill(1e300);
-    hi_.fill(-1e300);
-    seen_ = false;
-}
-
-void Calibration::observe(const DeviceState& s)
-{
-    if (!seen_) reset();
-    seen_ = true;
-    for (std::size_t i = 1; i < lo_.size(); ++i) {
-        const double v = read(s, static_cast<Source>(i));
-        lo_[i] = std::min(lo_[i], v);
-        hi_[i] = std::max(hi_[i], v);
-    }
-}
-
-void Calibration::apply(HidMapping& m) const
-{
-    if (!seen_) return;
-    auto fit = [&](Source src, Curve& c) {
-        const auto i = static_cast<std::size_t>(src);
-        if (src == Source::None || hi_[i] - lo_[i] < 0.05 * std::abs(c.inMax - c.inMin)) return;
-        c.inMin = lo_[i];
-        c.inMax = hi_[i];
-    };
-    fit(m.force, m.forceCurve);
-    fit(m.position, m.positionCurve);
-    if (!m.speedFromMotion) fit(m.speed, m.speedCurve);
-}
-
 void BowMapper::reset()
 {
     haveLast_ = wasEngaged_ = false;
@@ -352,12 +349,37 @@ void BowMapper::reset()
     direction_ = 0;
     heldTipNote_ = -1;
     lastButtons_ = 0;
+    held_.clear();
 }
 
-BowCommand BowMapper::update(const DeviceState& s, double seconds)
+void BowMapper::noteOn(int note, double seconds, std::vector<Event>& out)
+{
+    if (note < 0 || std::find(held_.begin(), held_.end(), note) != held_.end()) return;
+    held_.push_back(note);
+    Event e;
+    e.kind = Event::Kind::NoteOn;
+    e.seconds = seconds;
+    e.note = static_cast<std::int8_t>(note);
+    out.push_back(e);
+}
+
+void BowMapper::noteOff(int note, double seconds, std::vector<Event>& out)
+{
+    const auto it = std::find(held_.begin(), held_.end(), note);
+    if (note < 0 || it == held_.end()) return;
+    held_.erase(it);
+    Event e;
+    e.kind = Event::Kind::NoteOff;
+    e.seconds = seconds;
+    e.note = static_cast<std::int8_t>(note);
+    out.push_back(e);
+}
+
+void BowMapper::update(const DeviceState& s, double seconds, std::vector<Event>& out)
 {
     const HidMapping& m = mapping_;
-    BowCommand c;
+    Event c;
+    c.kind = Event::Kind::Bow;
     c.seconds = seconds;
     const double force = m.force == Source::None ? 0.0 : m.forceCurve(read(s, m.force));
     c.engaged = m.requireTip ? (s.tip || (s.inRange && s.pressure > 0.0)) : force > 1e-4;
@@ -374,6 +396,7 @@ BowCommand BowMapper::update(const DeviceState& s, double seconds)
     } else {
         speed_ = m.speed == Source::None ? 0.0 : m.speedCurve(read(s, m.speed));
     }
+    if (!std::isfinite(speed_)) speed_ = 0.0;
     haveLast_ = true;
     lastTime_ = seconds;
 
@@ -382,46 +405,38 @@ BowCommand BowMapper::update(const DeviceState& s, double seconds)
         c.bowChange = direction_ != 0 && dir != direction_ && c.engaged;
         direction_ = dir;
     }
-    c.force = static_cast<float>(c.engaged ? force : 0.0);
-    c.speed = static_cast<float>(std::clamp(speed_, -5.0, 5.0));
-    c.beta = static_cast<float>(m.position == Source::None ? 0.1 : std::clamp(m.positionCurve(read(s, m.position)), 0.02, 0.3));
+    c.force = static_cast<float>(c.engaged ? std::clamp(force, 0.0, 1.0) : 0.0);
+    c.speed = static_cast<float>(std::clamp(speed_, -1.0, 1.0));
+    c.position = static_cast<float>(m.position == Source::None ? 0.5 : std::clamp(m.positionCurve(read(s, m.position)), 0.0, 1.0));
     if (m.stringSelect != Source::None && m.strings > 0)
-        c.string = std::clamp(static_cast<int>(m.stringCurve(read(s, m.stringSelect)) * m.strings), 0, m.strings - 1);
+        c.string = static_cast<std::int8_t>(std::clamp(static_cast<int>(m.stringCurve(read(s, m.stringSelect)) * m.strings), 0, m.strings - 1));
+    out.push_back(c);
 
-    auto trigger = [&](bool on, int note) {
-        if (note < 0) return;
-        std::int8_t& slot = on ? (c.noteOn < 0 ? c.noteOn : c.noteOn2) : (c.noteOff < 0 ? c.noteOff : c.noteOff2);
-        slot = static_cast<std::int8_t>(note);
-    };
     if (c.engaged && !wasEngaged_ && m.tipNote >= 0 && m.requireTip) {
         heldTipNote_ = m.tipNote;
-        trigger(true, heldTipNote_);
+        noteOn(heldTipNote_, seconds, out);
     }
     if (!c.engaged && wasEngaged_ && heldTipNote_ >= 0) {
-        trigger(false, heldTipNote_);
+        noteOff(heldTipNote_, seconds, out);
         heldTipNote_ = -1;
     }
     for (std::size_t b = 0; b < m.buttonNotes.size(); ++b) {
         const bool now = s.buttons & (1ull << b), before = lastButtons_ & (1ull << b);
-        if (now != before) trigger(now, m.buttonNotes[b]);
+        if (now && !before) noteOn(m.buttonNotes[b], seconds, out);
+        if (!now && before) noteOff(m.buttonNotes[b], seconds, out);
     }
     lastButtons_ = s.buttons;
     wasEngaged_ = c.engaged;
-    return c;
 }
 
-BowCommand BowMapper::release(double seconds)
+void BowMapper::release(double seconds, std::vector<Event>& out)
 {
-    BowCommand c;
-    c.seconds = seconds;
-    c.engaged = false;
-    if (heldTipNote_ >= 0) c.noteOff = static_cast<std::int8_t>(heldTipNote_);
-    for (std::size_t b = 0; b < mapping_.buttonNotes.size(); ++b)
-        if ((lastButtons_ & (1ull << b)) && mapping_.buttonNotes[b] >= 0) {
-            (c.noteOff < 0 ? c.noteOff : c.noteOff2) = static_cast<std::int8_t>(mapping_.buttonNotes[b]);
-        }
+    while (!held_.empty()) noteOff(held_.back(), seconds, out);
+    Event r;
+    r.kind = Event::Kind::Released;
+    r.seconds = seconds;
+    out.push_back(r);
     reset();
-    return c;
 }
 
 } // namespace rosin::hid

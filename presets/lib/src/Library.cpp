@@ -84,12 +84,12 @@ Document Library::openPath(const std::string& relativePath, const std::string& f
     for (const auto& folder : folders_)
         if (fs::is_regular_file(folder / relativePath, ec)) {
             Document d = Document::parse(readFile(folder / relativePath), (folder / relativePath).string());
-            d.requireFormat(format);
+            if (!format.empty()) d.requireFormat(format);
             return d;
         }
     if (const FactoryEntry* e = factoryFind(relativePath)) {
         Document d = Document::parse(std::string(e->text, e->size), "factory:" + relativePath);
-        d.requireFormat(format);
+        if (!format.empty()) d.requireFormat(format);
         return d;
     }
     throw PresetError("no preset '" + relativePath + "' (neither in the factory set nor in a user folder)");
@@ -100,7 +100,7 @@ Document Library::open(const std::string& kind, const std::string& nameOrPath, c
     const fs::path asPath(nameOrPath);
     if (asPath.extension() == ".json" || nameOrPath.find('/') != std::string::npos) {
         Document d = Document::parse(readFile(asPath), asPath.string());
-        d.requireFormat(format);
+        if (!format.empty()) d.requireFormat(format);
         return d;
     }
     if (!has(kind, nameOrPath)) {

@@ -1,93 +1,74 @@
-// MIDI-learn table: which controller drives which parameter, over what range. Written by the
-// audio thread (a learn completes when the armed controller moves) and by the message thread
-// (state restore, mapping presets); every field is a single-word atomic, so neither side waits.
+// MIDI-learn: which controller drives which parameter, over what range. The table is a value:
+// the message side (the editor, a mapping preset, a restored session, a learn that the audio
+// thread reported) builds a new one and hands it over whole; the audio thread reads the table it
+// took at the top of its block and never sees a half-written one. Old tables are freed by the
+// housekeeping thread (rt::Handoff).
 #pragma once
 #include <array>
 #include <atomic>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include "rosin/engine/Presets.h"
+#include "rosin/rt/Handoff.h"
 
 namespace rosin::engine {
 
+struct ControllerTable {
+    static constexpr int numControllers = 120; // 120-127 are channel-mode messages
+    std::array<MappingEntry, numControllers> slots{};
+
+    ControllerTable()
+    {
+        for (int cc = 0; cc < numControllers; ++cc) slots[static_cast<std::size_t>(cc)].cc = cc;
+    }
+    const MappingEntry& get(int cc) const noexcept
+    {
+        static const MappingEntry none{};
+        return cc >= 0 && cc < numControllers ? slots[static_cast<std::size_t>(cc)] : none;
+    }
+};
+
 class ControllerMap {
 public:
-    static constexpr int numControllers = 120; // 120-127 are channel-mode messages
+    static constexpr int numControllers = ControllerTable::numControllers;
 
-    ControllerMap() { clear(); }
+    ControllerMap();
+    ~ControllerMap() { delete retiring_; }
+    ControllerMap(const ControllerMap&) = delete;
+    ControllerMap& operator=(const ControllerMap&) = delete;
 
-    void clear() noexcept
-    {
-        for (auto& s : slots_) {
-            s.param.store(-1, std::memory_order_relaxed);
-            s.min.store(0.0f, std::memory_order_relaxed);
-            s.max.store(1.0f, std::memory_order_relaxed);
-            s.invert.store(false, std::memory_order_relaxed);
-        }
-        learnParam_.store(-1, std::memory_order_release);
-    }
-
-    /// Assign a controller; param -1 clears it. min/max in the parameter's own units.
-    void set(int cc, int param, float min, float max, bool invert) noexcept
-    {
-        if (cc < 0 || cc >= numControllers) return;
-        Slot& s = slots_[static_cast<std::size_t>(cc)];
-        s.min.store(min, std::memory_order_relaxed);
-        s.max.store(max, std::memory_order_relaxed);
-        s.invert.store(invert, std::memory_order_relaxed);
-        s.param.store(param, std::memory_order_release);
-    }
-
-    MappingEntry get(int cc) const noexcept
-    {
-        if (cc < 0 || cc >= numControllers) return {};
-        const Slot& s = slots_[static_cast<std::size_t>(cc)];
-        MappingEntry e;
-        e.cc = cc;
-        e.param = s.param.load(std::memory_order_acquire);
-        e.min = s.min.load(std::memory_order_relaxed);
-        e.max = s.max.load(std::memory_order_relaxed);
-        e.invert = s.invert.load(std::memory_order_relaxed);
-        return e;
-    }
+    // [message side: any thread but audio; serialised inside]
+    /// Assign a controller; param -1 clears it. min/max in the parameter's own units. One
+    /// controller drives one parameter.
+    void set(int cc, int param, float min, float max, bool invert);
+    /// Replace the whole table.
+    void assign(const std::vector<MappingEntry>& list);
+    void clear() { assign({}); }
+    MappingEntry get(int cc) const;
+    std::vector<MappingEntry> entries() const;
 
     /// [any thread] The next controller that moves is assigned to `param` over its full range.
     void armLearn(int param) noexcept { learnParam_.store(param, std::memory_order_release); }
     int learning() const noexcept { return learnParam_.load(std::memory_order_acquire); }
+    /// [audio thread] Claims the armed learn (once): the parameter, or -1.
+    int claimLearn() noexcept { return learnParam_.exchange(-1, std::memory_order_acq_rel); }
 
-    /// [audio thread] Called for every controller; completes a pending learn. Returns true
-    /// when it did (the controller's value then applies to the new target at once).
-    bool offerForLearn(int cc, float fullMin, float fullMax) noexcept
-    {
-        int armed = learnParam_.load(std::memory_order_acquire);
-        if (armed < 0 || cc < 0 || cc >= numControllers) return false;
-        if (!learnParam_.compare_exchange_strong(armed, -1, std::memory_order_acq_rel)) return false;
-        // One controller drives one parameter: a controller already mapped elsewhere moves.
-        set(cc, armed, fullMin, fullMax, false);
-        return true;
-    }
-
-    std::vector<MappingEntry> entries() const
-    {
-        std::vector<MappingEntry> out;
-        for (int cc = 0; cc < numControllers; ++cc)
-            if (const MappingEntry e = get(cc); e.param >= 0) out.push_back(e);
-        return out;
-    }
-
-    void assign(const std::vector<MappingEntry>& list) noexcept
-    {
-        for (int cc = 0; cc < numControllers; ++cc) set(cc, -1, 0.0f, 1.0f, false);
-        for (const auto& e : list) set(e.cc, e.param, e.min, e.max, e.invert);
-    }
+    /// [audio thread] The newest table, taken at the top of a block (the one it replaces is
+    /// retired). Never null.
+    const ControllerTable& acquire() noexcept;
+    /// [housekeeping thread] Frees retired tables.
+    void collect() { handoff_.collect(); }
 
 private:
-    struct Slot {
-        std::atomic<int> param{-1};
-        std::atomic<float> min{0.0f}, max{1.0f};
-        std::atomic<bool> invert{false};
-    };
-    std::array<Slot, numControllers> slots_;
+    void publishLocked();
+
+    mutable std::mutex mutex_; ///< message-side writers only; never taken on the audio thread
+    ControllerTable edited_;   ///< the message side's copy
+    rt::Handoff<ControllerTable, 64> handoff_;
+    std::unique_ptr<ControllerTable> active_; ///< [audio thread] the table in use
+    ControllerTable* retiring_ = nullptr;     ///< [audio thread] replaced, waiting for room in the retire queue
     std::atomic<int> learnParam_{-1};
 };
 

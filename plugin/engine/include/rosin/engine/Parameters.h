@@ -52,8 +52,11 @@ struct ParamInfo {
     std::string_view unit;
     float min, max, def;
     float centre;           ///< value at the middle of a slider (skew), = (min+max)/2 for linear
-    int steps;              ///< 0 continuous; n > 0: integer values min..max (choices)
-    std::string_view choices; ///< '|'-separated names of the steps, empty if not a choice
+    /// 0 continuous; n > 0 a choice with n host slots. A choice that may grow has more slots
+    /// than names: the spare ones play the last choice, and a choice added later takes a spare
+    /// slot, so the normalised value of every existing choice (automation, sessions) stays put.
+    int steps;
+    std::string_view choices; ///< '|'-separated names of the choices min..max, empty if not a choice
 };
 
 /// The table of every parameter, indexed by Param.

@@ -1,6 +1,6 @@
 // The HID input thread: finds a controller (hot-plug: devices come and go while playing), reads
-// its reports, decodes and maps them, and hands BowCommands to the audio thread through a
-// lock-free SPSC queue. The device layer is an interface so tests drive it with a fake device;
+// its reports, decodes and maps them, and hands Events (the bow, note transitions, time-stamped)
+// to the audio thread through a lock-free SPSC queue. The device layer is an interface so tests drive it with a fake device;
 // HidapiBackend is the real one (hidapi's hidraw backend; descriptors from sysfs).
 #pragma once
 #include <atomic>
@@ -44,16 +44,15 @@ std::unique_ptr<DeviceBackend> makeHidapiBackend();
 
 class HidInput {
 public:
-    using Queue = rt::SpscQueue<BowCommand, 1024>;
+    using Queue = rt::SpscQueue<Event, 1024>;
 
     explicit HidInput(std::unique_ptr<DeviceBackend> backend);
     ~HidInput();
 
-    /// [message thread] Mapping per device kind (the one used when such a device is opened).
+    /// [message thread] Mapping per device kind; a connected device of that kind follows it at
+    /// its next report, without reconnecting.
     void setMapping(const HidMapping& m);
     HidMapping mapping(DeviceKind kind) const;
-    /// Only devices with this vendor:product (0 = any recognised controller).
-    void setFilter(std::uint16_t vendor, std::uint16_t product);
 
     /// Replace the device layer (tests: a fake device). Only while stopped; ignored otherwise.
     bool setBackend(std::unique_ptr<DeviceBackend> backend);
@@ -62,7 +61,7 @@ public:
     void stop();
     bool running() const { return running_.load(); }
 
-    /// [audio thread] Drain: the latest command wins for the bow; every note trigger counts.
+    /// [audio thread] Drain it every block: events in the order they happened.
     Queue& queue() { return queue_; }
 
     /// What the thread is doing, for people: "no controller", "Wacom ... (tablet)", "... unplugged",
@@ -76,7 +75,7 @@ public:
 private:
     void run();
     void setStatus(const std::string& s);
-    bool push(const BowCommand& c);
+    bool push(const Event& e);
 
     std::unique_ptr<DeviceBackend> backend_;
     Queue queue_;
@@ -84,10 +83,10 @@ private:
     std::atomic<bool> running_{false}, stopRequested_{false};
     std::atomic<std::uint64_t> reports_{0};
     std::atomic<int> connections_{0};
-    mutable std::mutex mutex_; ///< guards status_, mappings_ and the filter (never the audio thread)
+    mutable std::mutex mutex_; ///< guards status_ and mappings_ (never the audio thread)
     std::string status_ = "stopped";
     std::vector<HidMapping> mappings_;
-    std::uint16_t filterVendor_ = 0, filterProduct_ = 0;
+    std::atomic<unsigned> mappingGeneration_{0}; ///< bumped by setMapping: the thread picks the change up
 };
 
 } // namespace rosin::hid

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "rosin/hid/Descriptor.h"
 #include "rosin/presets/Document.h"
@@ -67,72 +68,77 @@ struct Curve {
     double operator()(double x) const;
 };
 
+/// How a device plays the bow. Outputs are the parameter layer's normalised controls, the same
+/// a MIDI controller sends: force 0..1 and position 0..1 (0.5 = the instrument's nominal bow
+/// force and position), speed -1..1 (0.5 = the nominal bow speed; the sign is the direction).
+/// The instrument maps them to newtons, m/s and beta in one place, with its per-string scaling.
 struct HidMapping {
     std::string name = "tablet";
     DeviceKind kind = DeviceKind::Tablet;
     Source force = Source::Pressure;
-    Curve forceCurve{0.0, 1.0, 0.0, 2.5, 1.5};      ///< N
+    Curve forceCurve{0.0, 1.0, 0.0, 1.0, 1.5};       ///< 0.5 = nominal force
     Source speed = Source::X;
-    bool speedFromMotion = true;                    ///< speed = d(source)/dt x speedScale (tablets)
-    double speedScale = 0.22;                       ///< m/s per (full range)/s: a 22 cm wide tablet
-    Curve speedCurve{-1.0, 1.0, -0.6, 0.6, 1.0, 0.08}; ///< direct sources (sticks): m/s
-    double speedSmoothing = 0.03;                   ///< s (the derivative of ~100-1000 Hz reports)
+    bool speedFromMotion = true;                     ///< speed = d(source)/dt x speedScale (tablets)
+    double speedScale = 0.75;                        ///< normalised speed per (full range)/s
+    Curve speedCurve{-1.0, 1.0, -1.0, 1.0, 1.0, 0.08}; ///< direct sources (sticks)
+    double speedSmoothing = 0.03;                    ///< s (the derivative of ~100-1000 Hz reports)
     Source position = Source::Y;
-    Curve positionCurve{0.0, 1.0, 0.03, 0.25};      ///< beta
+    Curve positionCurve{0.0, 1.0, 0.0, 1.0};         ///< 0.5 = nominal position
     Source stringSelect = Source::TiltX;
-    Curve stringCurve{-0.6, 0.6, 0.0, 1.0};         ///< 0..1 split evenly over the strings
+    Curve stringCurve{-0.6, 0.6, 0.0, 1.0};          ///< 0..1 split evenly over the strings
     int strings = 4;
-    bool requireTip = true;                         ///< tablets: the bow is on the string while the pen touches
-    int tipNote = 50;                               ///< note played while the pen touches (-1: none, keyboard plays)
+    bool requireTip = true;                          ///< tablets: the bow is on the string while the pen touches
+    int tipNote = 50;                                ///< note played while the pen touches (-1: none, keyboard plays)
     std::array<int, 8> buttonNotes{-1, -1, -1, -1, -1, -1, -1, -1}; ///< button n+1 holds this note
-    double bowChangeThreshold = 0.02;               ///< m/s: a sign change beyond this is a bow change
+    double bowChangeThreshold = 0.05;                ///< normalised speed: a sign change beyond this is a bow change
 
     static HidMapping defaultFor(DeviceKind kind);
-    std::string toJson() const;
-    /// From JSON (rosin-hid/1). Throws presets::PresetError naming `where` and the field.
+    std::string toJson() const; ///< rosin-hid/2
+    /// From JSON: rosin-hid/2, or rosin-hid/1 (physical units, converted with the instruments'
+    /// default nominal bow: 1.1 N, 0.15 m/s, beta 0.0899). Throws presets::PresetError naming
+    /// `where` and the field.
     static HidMapping fromJson(const std::string& text, const std::string& where);
     static HidMapping fromDocument(const presets::Document& document);
 };
 
-/// What the HID thread sends to the audio thread (through the SPSC queue).
-struct BowCommand {
-    double seconds = 0.0;
-    float force = 0.0f, speed = 0.0f, beta = 0.1f; ///< N, m/s (signed), fraction of the string
-    int string = -1;                               ///< selected string, -1 none
-    bool engaged = false;                          ///< the bow is on the string
-    bool bowChange = false;                        ///< the direction flipped at this command
-    std::int8_t noteOn = -1, noteOff = -1;         ///< note triggers (MIDI numbers)
-    std::int8_t noteOn2 = -1, noteOff2 = -1;       ///< a second trigger in the same report
-};
-
-/// Observes min/max of every source while calibrating; applies them as curve input ranges.
-class Calibration {
-public:
-    void reset();
-    void observe(const DeviceState& s);
-    void apply(HidMapping& m) const; ///< only sources that moved by more than 5 % of their range
-private:
-    std::array<double, 15> lo_{}, hi_{};
-    bool seen_ = false;
+/// What the HID thread sends to the audio thread, in order, through the SPSC queue: the bow
+/// after each report, then every note that started or ended in it; Released when the device
+/// is gone or the input stops (after a NoteOff for every note it held).
+struct Event {
+    enum class Kind : std::uint8_t { Bow, NoteOn, NoteOff, Released };
+    Kind kind = Kind::Bow;
+    double seconds = 0.0;            ///< steady-clock time of the report (the audio thread's frame offset)
+    float force = 0.0f, speed = 0.0f, position = 0.5f; ///< normalised (HidMapping)
+    std::int8_t string = -1;         ///< the string chosen, -1 none
+    std::int8_t note = -1;           ///< NoteOn / NoteOff
+    bool engaged = false;            ///< the bow is on the string
+    bool bowChange = false;          ///< the direction flipped at this report
 };
 
 class BowMapper {
 public:
     explicit BowMapper(HidMapping mapping = {}) : mapping_(std::move(mapping)) {}
     const HidMapping& mapping() const { return mapping_; }
+    /// A new mapping takes effect at the next report; notes held stay held.
     void setMapping(const HidMapping& m) { mapping_ = m; }
     void reset();
-    /// The bow after this state at this time (seconds, monotonic).
-    BowCommand update(const DeviceState& s, double seconds);
-    /// The release sent when the device disappears mid-note.
-    BowCommand release(double seconds);
+    /// Appends the events of this state at this time (seconds, monotonic): a Bow event, then the
+    /// note transitions, however many the report holds.
+    void update(const DeviceState& s, double seconds, std::vector<Event>& out);
+    /// The device is gone or the input stops: a NoteOff for every held note, then Released.
+    void release(double seconds, std::vector<Event>& out);
+    int heldNotes() const { return static_cast<int>(held_.size()); }
 
 private:
+    void noteOn(int note, double seconds, std::vector<Event>& out);
+    void noteOff(int note, double seconds, std::vector<Event>& out);
+
     HidMapping mapping_;
     bool haveLast_ = false, wasEngaged_ = false;
     double lastTime_ = 0.0, lastCoord_ = 0.0, speed_ = 0.0;
     int direction_ = 0, heldTipNote_ = -1;
     std::uint64_t lastButtons_ = 0;
+    std::vector<int> held_; ///< notes this device holds now
 };
 
 } // namespace rosin::hid

@@ -31,7 +31,8 @@ public:
 
     /// The text of "kind/name.json" from the first folder that has it, else the factory set. A
     /// name ending in .json or holding a '/' is a file path. Throws PresetError listing what
-    /// exists when nothing matches.
+    /// exists when nothing matches. An empty `format` leaves the check to the reader (a kind
+    /// with several versions).
     Document open(const std::string& kind, const std::string& nameOrPath, const std::string& format) const;
     /// A preset that names another one by its path inside the set ("strings/cello.json").
     Document openPath(const std::string& relativePath, const std::string& format) const;
