@@ -4,10 +4,19 @@
 # lilv (lv2ls/lv2info) must see and validate the LV2 bundle. Used by scripts/test.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-artefacts=$(realpath "${1:-build/plugin/RosinPlugin_artefacts/Release}")
-lv2="$artefacts/LV2"
-vst3="$artefacts/VST3"
-[[ -d "$lv2/Rosin.lv2" && -d "$vst3/Rosin.vst3" ]] || { echo "ardour-check: build the plugin first ($artefacts)" >&2; exit 1; }
+# With --installed HOME the bundles are read from HOME/.lv2 and HOME/.vst3 (a user's install)
+# and Ardour searches its default paths instead of being told where.
+installed=""
+if [[ "${1:-}" == "--installed" ]]; then
+  installed=$(realpath "$2")
+  lv2="$installed/.lv2"
+  vst3="$installed/.vst3"
+else
+  artefacts=$(realpath "${1:-build/plugin/RosinPlugin_artefacts/Release}")
+  lv2="$artefacts/LV2"
+  vst3="$artefacts/VST3"
+fi
+[[ -d "$lv2/Rosin.lv2" && -d "$vst3/Rosin.vst3" ]] || { echo "ardour-check: no Rosin bundles in $lv2 and $vst3" >&2; exit 1; }
 
 echo "== lilv"
 LV2_PATH="$lv2" lv2ls | grep -qx "http://rosin-synth.org/plugins/rosin" || { echo "lv2ls does not list Rosin" >&2; exit 1; }
@@ -22,7 +31,12 @@ command -v ardour7-lua >/dev/null || { echo "ardour7-lua missing (package ardour
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # Ardour finds VST3 plugins through its scanner's cache, as a DAW user's first scan would.
-LD_LIBRARY_PATH=/usr/lib/ardour7 /usr/lib/ardour7/ardour-vst3-scanner -q -f "$vst3/Rosin.vst3"
-ROSIN_ARDOUR_SESSION="$work/session" LV2_PATH="$lv2" VST3_PATH="$vst3" \
-  timeout 180 ardour7-lua scripts/ardour/check-rosin.lua 2>&1 | grep -v "No synth for midi-audition" | tee "$work/log"
+HOME="${installed:-$HOME}" LD_LIBRARY_PATH=/usr/lib/ardour7 /usr/lib/ardour7/ardour-vst3-scanner -q -f "$vst3/Rosin.vst3"
+if [[ -n "$installed" ]]; then
+  ROSIN_ARDOUR_SESSION="$work/session" HOME="$installed" \
+    timeout 180 ardour7-lua scripts/ardour/check-rosin.lua 2>&1 | grep -v "No synth for midi-audition" | tee "$work/log"
+else
+  ROSIN_ARDOUR_SESSION="$work/session" LV2_PATH="$lv2" VST3_PATH="$vst3" \
+    timeout 180 ardour7-lua scripts/ardour/check-rosin.lua 2>&1 | grep -v "No synth for midi-audition" | tee "$work/log"
+fi
 grep -q "ardour check passed" "$work/log"

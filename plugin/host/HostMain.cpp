@@ -12,6 +12,7 @@
 
 #include "AuditCounter.h"
 #include "PluginHost.h"
+#include "Validate.h"
 #include "rosin/presets/Presets.h"
 #include "rosin/hid/HidInput.h"
 
@@ -49,6 +50,17 @@ std::vector<Automation> readAutomation(const fs::path& file)
         out.push_back(a);
     }
     return out;
+}
+
+nlohmann::json auditJson(const rosin::host::audit::Tally& t)
+{
+    return {{"allocations", t.allocations}, {"frees", t.frees}, {"locks", t.locks}, {"waits", t.waits}, {"blocking_calls", t.blocking}};
+}
+
+std::string auditText(const rosin::host::audit::Tally& t)
+{
+    return std::to_string(t.allocations) + " allocations, " + std::to_string(t.frees) + " frees, " + std::to_string(t.locks) + " locks, " +
+           std::to_string(t.waits) + " condition/semaphore calls, " + std::to_string(t.blocking) + " blocking calls";
 }
 
 std::vector<char> readBytes(const fs::path& file)
@@ -103,6 +115,19 @@ int main(int argc, char** argv)
     bench->add_option("--freq", freq, "pitch of the held note (Hz), rounded to a MIDI note")->check(CLI::Range(20.0, 5000.0));
     bench->add_option("--voices", voices, "notes held at once (a chord spread over the range)")->check(CLI::Range(1, 16));
     bench->add_option("--preset", benchPreset, "instrument preset");
+
+    auto* validateCmd = app.add_subcommand("validate", "a validation pass like pluginval's: open/close, parameters moved from another "
+                                                       "thread, state mid-note, rates and block sizes, mono/stereo, offline, "
+                                                       "denormals, and the real-time audit; exit status = failed checks");
+    rosin::host::ValidateOptions validateOptions;
+    std::string hidReplay;
+    validateCmd->add_option("--plugin", plugin, "the built plugin bundle (.vst3 or .lv2)")->required();
+    validateCmd->add_option("--cycles", validateOptions.openCloseCycles, "open/close cycles")->check(CLI::Range(1, 1000));
+    validateCmd->add_option("--walk-seconds", validateOptions.walkSeconds, "audio while parameters random-walk")->check(CLI::Range(0.1, 600.0));
+    validateCmd->add_option("--hid-replay", hidReplay, "a hid-recorder capture played as a controller while the audit runs");
+
+    auto* presetsCmd = app.add_subcommand("presets", "list the instrument presets the plugin carries (from inside its bundle)");
+    presetsCmd->add_option("--plugin", plugin, "the built plugin bundle (.vst3 or .lv2)")->required();
 
     auto* params = app.add_subcommand("params", "list the plugin's parameters (ID, name, value)");
     params->add_option("--plugin", plugin, "the built plugin bundle (.vst3 or .lv2)")->required();
@@ -159,8 +184,24 @@ int main(int argc, char** argv)
         }
         return 0;
     }
+    if (validateCmd->parsed()) {
+        try {
+            validateOptions.hidReplay = hidReplay;
+            const int failed = rosin::host::validate(plugin, validateOptions, std::cout);
+            std::printf("%s: %s\n", plugin.c_str(), failed == 0 ? "passed every check" : (std::to_string(failed) + " check(s) failed").c_str());
+            return failed == 0 ? 0 : 4;
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "rosin-host: %s\n", e.what());
+            return 1;
+        }
+    }
     try {
         PluginHost host(plugin);
+        if (presetsCmd->parsed()) {
+            // The instrument choices are the instrument presets compiled into the plugin.
+            for (const auto& name : host.choices("instrument")) std::printf("%s\n", name.c_str());
+            return 0;
+        }
         if (bench->parsed()) {
             host.setParameter("instrument", benchPreset);
             std::vector<TimedMidi> notes;
@@ -225,19 +266,16 @@ int main(int argc, char** argv)
         nlohmann::json j{{"format", host.formatName()}, {"plugin", host.pluginName()}, {"rate", rate}, {"block", block},
                          {"seconds", req.seconds}, {"blocks", r.audit.blocks}, {"peak", peak}};
         if (audit)
-            j["audit"] = {{"allocations_in_processBlock", r.audit.allocationsInPlugin},
-                          {"locks_in_processBlock", r.audit.locksInPlugin},
-                          {"allocations_in_host_call", r.audit.allocationsInCall},
-                          {"locks_in_host_call", r.audit.locksInCall},
+            j["audit"] = {{"in_processBlock", auditJson(r.audit.plugin)},
+                          {"in_host_call", auditJson(r.audit.call)},
                           {"plugin_reported_scope", r.audit.pluginScopeSeen}};
         if (!report.empty()) std::ofstream(report) << j.dump(2) << "\n";
         std::fprintf(stderr, "rosin-host: %s %s, %.2f s at %.0f Hz in blocks of %d -> %s (peak %.3f)\n", host.formatName().c_str(),
                      host.pluginName().c_str(), req.seconds, rate, block, out.c_str(), peak);
         if (audit)
-            std::fprintf(stderr, "rosin-host: processBlock: %llu allocations, %llu locks over %llu blocks\n",
-                         static_cast<unsigned long long>(r.audit.allocationsInPlugin), static_cast<unsigned long long>(r.audit.locksInPlugin),
-                         static_cast<unsigned long long>(r.audit.blocks));
-        return audit && (r.audit.allocationsInPlugin > 0 || r.audit.locksInPlugin > 0) ? 3 : 0;
+            std::fprintf(stderr, "rosin-host: processBlock over %llu blocks: %s\n", static_cast<unsigned long long>(r.audit.blocks),
+                         auditText(r.audit.plugin).c_str());
+        return audit && r.audit.plugin.total() > 0 ? 3 : 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "rosin-host: %s\n", e.what());
         return 1;

@@ -20,6 +20,8 @@ struct PluginHost::Impl {
     juce::AudioPluginFormatManager formats;
     std::unique_ptr<juce::AudioPluginInstance> plugin;
     juce::MemoryBlock initialState;
+    juce::AudioBuffer<float> stream;
+    juce::MidiBuffer streamMidi;
     std::string format;
 
     /// A parameter by the plugin's own ID. Formats spell it differently: VST3 hosts see JUCE's
@@ -102,6 +104,17 @@ void PluginHost::setParameter(const std::string& id, const std::string& value)
     else v = p->getValueForText(juce::String(value));
     if (!std::isfinite(v)) throw std::runtime_error("parameter '" + id + "': value '" + value + "' is not a number");
     p->setValueNotifyingHost(std::clamp(v, 0.0f, 1.0f));
+}
+
+std::vector<std::string> PluginHost::choices(const std::string& id) const
+{
+    auto* p = impl_->find(id);
+    if (!p) throw std::runtime_error("no parameter '" + id + "' in " + pluginName());
+    std::vector<std::string> out;
+    for (const auto& s : p->getAllValueStrings()) out.push_back(s.toStdString());
+    if (out.empty()) // no list from the format: ask for the text of each step
+        for (int i = 0, n = std::max(2, p->getNumSteps()); i < n; ++i) out.push_back(p->getText(static_cast<float>(i) / static_cast<float>(n - 1), 256).toStdString());
+    return out;
 }
 
 HostedParam PluginHost::parameter(const std::string& id) const
@@ -198,13 +211,106 @@ RenderResult PluginHost::render(const RenderRequest& req)
     }
     const audit::Counts c = audit::read();
     if (req.audit) {
-        result.audit.allocationsInPlugin = c.allocationsInPlugin;
-        result.audit.locksInPlugin = c.locksInPlugin;
-        result.audit.allocationsInCall = c.allocationsInCall;
-        result.audit.locksInCall = c.locksInCall;
+        result.audit.plugin = c.plugin;
+        result.audit.call = c.call;
     }
     result.audit.pluginScopeSeen = c.scopeSeen;
     plugin.releaseResources();
+    return result;
+}
+
+void PluginHost::startStream(double sampleRate, int maxBlock, bool realtime, int outputChannels)
+{
+    auto& plugin = *impl_->plugin;
+    auto layout = plugin.getBusesLayout();
+    if (layout.outputBuses.isEmpty()) throw std::runtime_error(pluginName() + ": no output bus");
+    layout.outputBuses.getReference(0) = outputChannels == 1 ? juce::AudioChannelSet::mono() : juce::AudioChannelSet::stereo();
+    if (!plugin.setBusesLayout(layout))
+        throw std::runtime_error(pluginName() + " (" + impl_->format + ") refuses " + (outputChannels == 1 ? "a mono" : "a stereo") + " output");
+    plugin.setNonRealtime(!realtime);
+    plugin.setPlayConfigDetails(0, outputChannels, sampleRate, maxBlock);
+    plugin.prepareToPlay(sampleRate, maxBlock);
+    impl_->stream.setSize(std::max(2, plugin.getTotalNumOutputChannels()), maxBlock);
+    impl_->streamMidi.ensureSize(4096);
+}
+
+void PluginHost::processStream(int n, const std::vector<std::pair<int, std::vector<std::uint8_t>>>& midi, float* left, float* right,
+                               bool audited)
+{
+    auto& buffer = impl_->stream;
+    buffer.setSize(buffer.getNumChannels(), n, false, false, true);
+    buffer.clear();
+    impl_->streamMidi.clear();
+    for (const auto& [frame, bytes] : midi) impl_->streamMidi.addEvent(bytes.data(), static_cast<int>(bytes.size()), std::clamp(frame, 0, n - 1));
+    if (audited) audit::enterCall();
+    impl_->plugin->processBlock(buffer, impl_->streamMidi);
+    if (audited) audit::exitCall();
+    std::copy_n(buffer.getReadPointer(0), n, left);
+    if (right) std::copy_n(buffer.getReadPointer(impl_->plugin->getTotalNumOutputChannels() > 1 ? 1 : 0), n, right);
+}
+
+void PluginHost::stopStream() { impl_->plugin->releaseResources(); }
+
+int PluginHost::parameterCount() const { return impl_->plugin->getParameters().size(); }
+
+void PluginHost::setParameterNormalised(int index, float value)
+{
+    const auto& params = impl_->plugin->getParameters();
+    if (index < 0 || index >= params.size()) throw std::runtime_error("no parameter " + std::to_string(index));
+    params[index]->setValueNotifyingHost(std::clamp(value, 0.0f, 1.0f));
+}
+
+std::vector<char> editRosinState(const std::vector<char>& hostState, const std::function<std::string(const std::string&)>& edit)
+{
+    // Both formats carry the processor's state as JUCE base64 ("size.chars"): inside the VST3
+    // state's IComponent element, or as the LV2 state's StateString literal.
+    auto editText = [&](juce::String text, bool& done) {
+        juce::String out;
+        int at = 0;
+        while (at < text.length()) {
+            const int dot = text.indexOfChar(at, '.');
+            if (dot < 0) break;
+            int start = dot;
+            while (start > 0 && juce::CharacterFunctions::isDigit(text[start - 1])) --start;
+            int end = dot + 1;
+            while (end < text.length() && (juce::CharacterFunctions::isLetterOrDigit(text[end]) || text[end] == '.' || text[end] == '+')) ++end;
+            juce::MemoryBlock block;
+            if (start < dot && end - dot > 16 && block.fromBase64Encoding(text.substring(start, end))) {
+                if (auto xml = juce::AudioProcessor::getXmlFromBinary(block.getData(), static_cast<int>(block.getSize()));
+                    xml && xml->hasTagName("RosinState")) {
+                    std::unique_ptr<juce::XmlElement> edited(juce::XmlDocument::parse(juce::String(edit(xml->toString().toStdString()))));
+                    if (!edited) throw std::runtime_error("editRosinState: the edited state is not XML");
+                    juce::MemoryBlock again;
+                    juce::AudioProcessor::copyXmlToBinary(*edited, again);
+                    out += text.substring(at, start) + again.toBase64Encoding();
+                    at = end;
+                    done = true;
+                    continue;
+                }
+            }
+            out += text.substring(at, dot + 1);
+            at = dot + 1;
+        }
+        return out + text.substring(at);
+    };
+    bool done = false;
+    std::vector<char> result;
+    if (auto outer = juce::AudioProcessor::getXmlFromBinary(hostState.data(), static_cast<int>(hostState.size()))) {
+        for (auto* e : outer->getChildIterator())
+            if (e->getFirstChildElement() != nullptr && e->getFirstChildElement()->isTextElement() && e->getAllSubText().length() > 16) {
+                const juce::String text = editText(e->getAllSubText(), done);
+                e->deleteAllTextElements();
+                e->addTextElement(text);
+            }
+        juce::MemoryBlock block;
+        juce::AudioProcessor::copyXmlToBinary(*outer, block);
+        result.assign(static_cast<const char*>(block.getData()), static_cast<const char*>(block.getData()) + block.getSize());
+    } else {
+        const juce::String text = editText(juce::String::fromUTF8(hostState.data(), static_cast<int>(hostState.size())), done);
+        const std::string s = text.toStdString();
+        result.assign(s.begin(), s.end());
+    }
+    if (!done) throw std::runtime_error("editRosinState: no Rosin state inside the host state");
     return result;
 }
 

@@ -4,9 +4,12 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "AuditCounter.h"
 
 namespace rosin::host {
 
@@ -38,8 +41,8 @@ struct RenderRequest {
 
 struct AuditCounts {
     std::uint64_t blocks = 0;
-    std::uint64_t allocationsInPlugin = 0, locksInPlugin = 0;   ///< inside Rosin's processBlock
-    std::uint64_t allocationsInCall = 0, locksInCall = 0;       ///< whole host->plugin call (wrappers too)
+    audit::Tally plugin; ///< inside Rosin's processBlock
+    audit::Tally call;   ///< the whole host -> plugin call (the format wrapper too)
     bool pluginScopeSeen = false; ///< the plugin reported its scope (it is Rosin, built with the hook)
 };
 
@@ -68,6 +71,8 @@ public:
     /// Sets a parameter by ID: "0.6" through the plugin's own text parser, "@0.25" normalised.
     void setParameter(const std::string& id, const std::string& value);
     float getParameter(const std::string& id) const;
+    /// The names of a discrete parameter's values, as the plugin reports them to the host.
+    std::vector<std::string> choices(const std::string& id) const;
     /// One parameter by ID (throws when the plugin has none by that ID).
     HostedParam parameter(const std::string& id) const;
 
@@ -78,6 +83,19 @@ public:
 
     /// Prepares at the request's rate and block (a fresh engine), then renders.
     RenderResult render(const RenderRequest& request);
+
+    // Streaming, as a DAW drives a plugin (the validation pass): start at a rate, block size,
+    // mode and output channel count (1 or 2: the bus layout), then blocks one at a time.
+    /// Throws when the plugin refuses the layout.
+    void startStream(double sampleRate, int maxBlock, bool realtime, int outputChannels);
+    /// One block of n <= maxBlock samples; MIDI as (frame, bytes). Writes n samples per output
+    /// channel (right is ignored for a mono layout). With `audited`, the audit counts this call.
+    void processStream(int n, const std::vector<std::pair<int, std::vector<std::uint8_t>>>& midi, float* left, float* right,
+                       bool audited);
+    void stopStream();
+    /// [any thread] A parameter by its index in parameters(), normalised: a host's automation thread.
+    void setParameterNormalised(int index, float value);
+    int parameterCount() const;
 
     /// Times processBlock as a DAW would call it (real-time mode): `midi` is sent in the first
     /// block, `warmup` seconds run untimed, then `reps` passes of `seconds` each are timed.
@@ -91,6 +109,9 @@ private:
 
 /// MIDI file (type 0 or 1, all tracks merged) to timed messages. Throws naming the file.
 std::vector<TimedMidi> readMidiFile(const std::filesystem::path& file);
+/// A saved host state (VST3 or LV2, as getState() returns it) with Rosin's own XML state edited by
+/// `edit` (it receives and returns the RosinState XML text). Throws when no Rosin state is inside.
+std::vector<char> editRosinState(const std::vector<char>& hostState, const std::function<std::string(const std::string&)>& edit);
 /// Text event list: "seconds hexbyte hexbyte ..." per line, '#' comments. Throws naming file and line.
 std::vector<TimedMidi> readEventList(const std::filesystem::path& file);
 /// Writes 32-bit float stereo WAV atomically (temp file + rename). Throws naming the file.

@@ -36,6 +36,14 @@ target_link_libraries(RosinPlugin
   PRIVATE rosin::engine rosin::hid rosin_lab_core juce::juce_audio_utils juce::juce_audio_plugin_client ${CMAKE_DL_LIBS}
   PUBLIC juce::juce_recommended_config_flags juce::juce_recommended_warning_flags)
 
+# Debian JUCE 7.0.5 quirk: enumerated LV2 parameters get normalised scale points (see the script).
+get_target_property(ROSIN_LV2_DIR RosinPlugin_LV2 LIBRARY_OUTPUT_DIRECTORY)
+add_executable(rosin_fix_lv2_scale_points ${CMAKE_CURRENT_SOURCE_DIR}/juce/fix_lv2_scale_points.cpp)
+add_dependencies(RosinPlugin_LV2 rosin_fix_lv2_scale_points)
+add_custom_command(TARGET RosinPlugin_LV2 POST_BUILD
+  COMMAND rosin_fix_lv2_scale_points ${ROSIN_LV2_DIR}/dsp.ttl
+  VERBATIM)
+
 # Headless host core: JUCE plugin hosting compiled once, behind a JUCE-free header.
 add_library(rosin_host_core STATIC ${CMAKE_CURRENT_SOURCE_DIR}/host/PluginHost.cpp)
 target_include_directories(rosin_host_core PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/host)
@@ -50,7 +58,8 @@ target_compile_features(rosin_host_core PUBLIC cxx_std_20)
 
 # The audit counter interposes malloc/pthread_mutex_lock: executables export it (-rdynamic)
 # so the dlopen'ed plugin binds to it.
-add_executable(rosin-host ${CMAKE_CURRENT_SOURCE_DIR}/host/HostMain.cpp ${CMAKE_CURRENT_SOURCE_DIR}/host/AuditCounter.cpp)
+add_executable(rosin-host ${CMAKE_CURRENT_SOURCE_DIR}/host/HostMain.cpp ${CMAKE_CURRENT_SOURCE_DIR}/host/AuditCounter.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/host/Validate.cpp)
 target_link_libraries(rosin-host PRIVATE rosin_host_core rosin::hid rosin::presets CLI11::CLI11 nlohmann_json::nlohmann_json ${CMAKE_DL_LIBS})
 set_target_properties(rosin-host PROPERTIES ENABLE_EXPORTS ON)
 add_dependencies(rosin-host RosinPlugin_VST3 RosinPlugin_LV2)

@@ -1,12 +1,14 @@
 #include "RosinProcessor.h"
 
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <thread>
 
 #include "RosinEditor.h"
 #include "StateFormat.h"
+#include "rosin/hid/Recording.h"
 #include "rosin/engine/Presets.h"
 
 // The headless host defines this (strong, exported) to count allocations and locks between
@@ -119,7 +121,17 @@ RosinProcessor::RosinProcessor()
     }
     instrumentRaw_ = state_.getRawParameterValue(instrumentParamId);
     hidRaw_ = state_.getRawParameterValue(hidParamId);
-    hid_ = std::make_unique<hid::HidInput>(hid::makeHidapiBackend());
+    // ROSIN_HID_REPLAY=capture.hid plays a recorded controller (demonstrations, the validation
+    // pass); otherwise the real devices through hidapi.
+    std::unique_ptr<hid::DeviceBackend> backend;
+    if (const char* replay = std::getenv("ROSIN_HID_REPLAY"); replay && *replay) {
+        try {
+            backend = hid::makeReplayBackend(hid::readRecording(replay), true);
+        } catch (const std::exception& e) {
+            stateProblem_ = juce::String("ROSIN_HID_REPLAY: ") + e.what();
+        }
+    }
+    hid_ = std::make_unique<hid::HidInput>(backend ? std::move(backend) : hid::makeHidapiBackend());
     pushed_.fill(std::numeric_limits<float>::quiet_NaN());
     const int index = juce::roundToInt(instrumentRaw_->load());
     requestedInstrument_.store(index);
@@ -272,6 +284,7 @@ void RosinProcessor::prepareToPlay(double sampleRate, int maximumExpectedSamples
         instrumentName_ = instrumentNames()[index];
         try {
             current_ = buildSynth(presets::loadInstrument(library_, instrumentName_.toStdString()), sampleRate, index).release();
+            enginesInstalled_.fetch_add(1, std::memory_order_relaxed);
         } catch (const std::exception& e) {
             DBG("Rosin: " << e.what()); // no engine: processBlock outputs silence
         }
@@ -329,6 +342,7 @@ void RosinProcessor::swapEngine() noexcept
     pushParameters(*current_, true);
     current_->resumeHeldNotes(); // the player still holds them: they sound on the new instrument
     installedInstrument_ = next->tag();
+    enginesInstalled_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void RosinProcessor::pushParameters(engine::Synth& synth, bool all) noexcept

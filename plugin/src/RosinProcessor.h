@@ -87,6 +87,11 @@ public:
     juce::String currentInstrument() const;
     engine::ParamValues currentParams() const; ///< [any thread] the host parameters in engine units
     int activeVoices() const noexcept { return activeVoices_.load(std::memory_order_relaxed); }
+    /// How many engines have been installed (a rebuild is one more): for tests and diagnostics.
+    int enginesInstalled() const noexcept { return enginesInstalled_.load(std::memory_order_relaxed); }
+    /// [audio thread, or a test between blocks] What the player holds, and the MIDI decoder.
+    const engine::Performance& performance() const noexcept { return performance_; }
+    const engine::MidiDecoder& decoder() const noexcept { return decoder_; }
 
     /// The live views' channel: the audio thread writes frames of the newest note while the
     /// editor listens (ViewRing::setListening); the editor's timer reads them.
@@ -156,6 +161,7 @@ private:
     std::atomic<int> requestedInstrument_{-1}; ///< [loader] the instrument it last started to build
     std::atomic<int> settledInstrument_{-1};   ///< the instrument whose build finished (an engine, or a failure)
     std::atomic<int> activeVoices_{0};
+    std::atomic<int> enginesInstalled_{0};
 
     mutable std::mutex loadMutex_; ///< serialises loaders (never taken on the audio thread)
     juce::String instrumentName_{"cello"};

@@ -41,6 +41,10 @@ public:
 
 /// hidapi (hidraw). The report descriptor comes from /sys/class/hidraw/hidrawN/device/report_descriptor.
 std::unique_ptr<DeviceBackend> makeHidapiBackend();
+struct Recording;
+/// A hid-recorder capture played back as a plugged-in device (its reports at their recorded
+/// times); `loop` plays it again and again, else the device unplugs at the end.
+std::unique_ptr<DeviceBackend> makeReplayBackend(Recording recording, bool loop);
 
 class HidInput {
 public:
