@@ -126,8 +126,11 @@ TEST(Editor, OpenAndCloseRepeatedlyWhileAudioRunsWithoutAllocatingOrLockingOnThe
 #ifndef ROSIN_EDITOR_ASAN
     const auto counts = host::audit::read();
     EXPECT_TRUE(counts.scopeSeen);
-    EXPECT_EQ(counts.allocationsInPlugin, 0u);
-    EXPECT_EQ(counts.locksInPlugin, 0u);
+    EXPECT_EQ(counts.plugin.allocations, 0u);
+    EXPECT_EQ(counts.plugin.frees, 0u);
+    EXPECT_EQ(counts.plugin.locks, 0u);
+    EXPECT_EQ(counts.plugin.waits, 0u);
+    EXPECT_EQ(counts.plugin.blocking, 0u);
 #endif
     EXPECT_GT(audio.blocks(), 200);
     EXPECT_GT(framesSeen, 48000u) << "the views received the sounding notes";

@@ -215,3 +215,269 @@ TEST(Processor, HidMappingsAreSavedWithTheState)
     EXPECT_DOUBLE_EQ(b.hidInput().mapping(rosin::hid::DeviceKind::Gamepad).forceCurve.outMax, 1.0);
     EXPECT_THROW(b.loadHidMapping("theremin"), std::runtime_error);
 }
+
+// ---- Issue 21: what a DAW user meets sooner or later ----
+namespace {
+juce::MidiBuffer messages(std::initializer_list<juce::MidiMessage> list)
+{
+    juce::MidiBuffer m;
+    for (const auto& x : list) m.addEvent(x, 0);
+    return m;
+}
+
+void blocks(RosinProcessor& p, int count, juce::MidiBuffer midi = {}, int size = 256)
+{
+    juce::AudioBuffer<float> buffer(2, size);
+    for (int b = 0; b < count; ++b) {
+        buffer.clear();
+        p.processBlock(buffer, midi);
+        midi.clear();
+    }
+}
+
+void setChoice(RosinProcessor& p, const char* id, int index)
+{
+    auto* param = p.parameters().getParameter(id);
+    param->setValueNotifyingHost(param->convertTo0to1(static_cast<float>(index)));
+}
+
+/// The processor's own state out of a VST3 state file as JUCE's VST3 host saves it.
+juce::MemoryBlock rosinStateOf(const juce::File& file)
+{
+    juce::MemoryBlock outer;
+    file.loadFileAsData(outer);
+    std::unique_ptr<juce::XmlElement> xml(juce::AudioProcessor::getXmlFromBinary(outer.getData(), static_cast<int>(outer.getSize())));
+    juce::MemoryBlock inner;
+    if (xml)
+        if (auto* component = xml->getChildByName("IComponent")) inner.fromBase64Encoding(component->getAllSubText());
+    return inner;
+}
+
+float raw(RosinProcessor& p, const char* id) { return p.parameters().getRawParameterValue(id)->load(); }
+} // namespace
+
+TEST(ProcessorSwap, AnInstrumentChangeKeepsZonesBendRangesPedalAndHeldNotes)
+{
+    juce::ScopedJuceInitialiser_GUI juce;
+    RosinProcessor p;
+    p.setPlayConfigDetails(0, 2, 48000.0, 256);
+    p.prepareToPlay(48000.0, 256);
+    p.setNonRealtime(true);
+    // An MPE controller configures its zone once (7 members), sets a member's bend range to 24,
+    // the pedal goes down and a note is held on member channel 3.
+    juce::MidiBuffer setup;
+    int at = 0;
+    for (const auto m : juce::MidiRPNGenerator::generate(1, 6, 7 << 7, false, true)) setup.addEvent(m.getMessage(), at++);
+    for (const auto m : juce::MidiRPNGenerator::generate(3, 0, 24 << 7, false, true)) setup.addEvent(m.getMessage(), at++);
+    setup.addEvent(juce::MidiMessage::controllerEvent(1, 64, 127), at++);
+    setup.addEvent(juce::MidiMessage::noteOn(3, 57, 0.8f), at++);
+    blocks(p, 40, setup);
+    ASSERT_EQ(p.activeVoices(), 1);
+    const int before = p.enginesInstalled();
+    setChoice(p, "instrument", 1); // viola
+    blocks(p, 40);
+    ASSERT_EQ(p.enginesInstalled(), before + 1);
+    EXPECT_EQ(p.currentInstrument(), "viola");
+    EXPECT_EQ(p.performance().lowerMembers(), 7);
+    EXPECT_TRUE(p.performance().channel(0).sustain);
+    EXPECT_FLOAT_EQ(p.decoder().bendRange(2, p.performance(), p.currentParams()), 24.0f);
+    EXPECT_EQ(p.activeVoices(), 1); // the held A3 sounds on the viola
+    ASSERT_EQ(p.performance().heldCount(), 1);
+    EXPECT_EQ(p.performance().held(0).note, 57);
+}
+
+TEST(ProcessorSwap, RestoringTheSameInstrumentKeepsItsEngine)
+{
+    juce::ScopedJuceInitialiser_GUI juce;
+    RosinProcessor p;
+    p.setPlayConfigDetails(0, 2, 48000.0, 256);
+    p.prepareToPlay(48000.0, 256);
+    blocks(p, 20, messages({juce::MidiMessage::noteOn(1, 50, 0.8f)}));
+    juce::MemoryBlock state;
+    p.getStateInformation(state);
+    const int before = p.enginesInstalled();
+    p.setStateInformation(state.getData(), static_cast<int>(state.getSize()));
+    blocks(p, 20);
+    EXPECT_EQ(p.enginesInstalled(), before); // no rebuild, so the note plays on undisturbed
+    EXPECT_EQ(p.activeVoices(), 1);
+    // prepareToPlay at the same rate keeps it too.
+    p.prepareToPlay(48000.0, 256);
+    EXPECT_EQ(p.enginesInstalled(), before);
+}
+
+TEST(ProcessorSwap, ABrokenPresetDoesNotStallOfflineRendering)
+{
+    // A user folder holds a broken violin preset: the build fails, and an offline render must
+    // not wait for an engine that will never come (it waited 5 s in every block).
+    const juce::File dir = juce::File::getSpecialLocation(juce::File::tempDirectory).getChildFile("rosin-broken-presets");
+    dir.getChildFile("instruments").createDirectory();
+    dir.getChildFile("instruments").getChildFile("violin.json").replaceWithText("{\"format\": \"rosin-instrument/1\", \"name\": ");
+    ::setenv("ROSIN_PRESETS", dir.getFullPathName().toRawUTF8(), 1);
+    juce::ScopedJuceInitialiser_GUI juce;
+    RosinProcessor p;
+    ::unsetenv("ROSIN_PRESETS");
+    p.setPlayConfigDetails(0, 2, 48000.0, 256);
+    p.prepareToPlay(48000.0, 256);
+    p.setNonRealtime(true);
+    setChoice(p, "instrument", 0);
+    const auto start = std::chrono::steady_clock::now();
+    blocks(p, 20, messages({juce::MidiMessage::noteOn(1, 62, 0.8f)}));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_LT(seconds, 3.0); // 20 blocks: 100 s before the fix
+    EXPECT_EQ(p.currentInstrument(), "cello"); // the cello plays on
+    EXPECT_EQ(p.activeVoices(), 1);
+    dir.deleteRecursively();
+}
+
+TEST(ProcessorState, StatesOfEarlierVersionsLoad)
+{
+    juce::ScopedJuceInitialiser_GUI juce;
+    const juce::File data(ROSIN_TEST_DATA "/state");
+    {
+        RosinProcessor p;
+        const auto s = rosinStateOf(data.getChildFile("v1-violin-pizzicato.state"));
+        ASSERT_GT(s.getSize(), 100u);
+        p.setStateInformation(s.getData(), static_cast<int>(s.getSize()));
+        EXPECT_EQ(p.lastStateProblem(), "");
+        EXPECT_FLOAT_EQ(raw(p, "instrument"), 0.0f); // violin
+        EXPECT_FLOAT_EQ(raw(p, "articulation"), 5.0f); // pizzicato
+        EXPECT_FLOAT_EQ(raw(p, "mute"), 1.0f);
+        EXPECT_FLOAT_EQ(raw(p, "gain"), -6.0f);
+        EXPECT_NEAR(raw(p, "bow_force"), 0.7f, 1e-6);
+        // Saved again it is the current version, and it reads back to the same state.
+        juce::MemoryBlock again;
+        p.getStateInformation(again);
+        std::unique_ptr<juce::XmlElement> xml(juce::AudioProcessor::getXmlFromBinary(again.getData(), static_cast<int>(again.getSize())));
+        EXPECT_EQ(xml->getStringAttribute("format"), "rosin-state/" + juce::String(RosinProcessor::stateVersion));
+        RosinProcessor q;
+        q.setStateInformation(again.getData(), static_cast<int>(again.getSize()));
+        juce::MemoryBlock third;
+        q.getStateInformation(third);
+        EXPECT_EQ(third, again);
+    }
+    {
+        RosinProcessor p;
+        const auto s = rosinStateOf(data.getChildFile("v1-learned-and-hid.state"));
+        p.setStateInformation(s.getData(), static_cast<int>(s.getSize()));
+        EXPECT_EQ(p.lastStateProblem(), "");
+        const auto force = p.controllerMap().get(21), ambient = p.controllerMap().get(74);
+        EXPECT_EQ(force.param, static_cast<int>(engine::Param::BowForce));
+        EXPECT_FLOAT_EQ(force.max, 3.0f);
+        EXPECT_EQ(ambient.param, static_cast<int>(engine::Param::Ambient));
+        EXPECT_TRUE(ambient.invert);
+        // The version-1 gamepad map reached 1.1 N: the nominal force, 0.5 in today's units.
+        EXPECT_NEAR(p.hidInput().mapping(rosin::hid::DeviceKind::Gamepad).forceCurve.outMax, 0.5, 1e-9);
+        EXPECT_NEAR(p.hidInput().mapping(rosin::hid::DeviceKind::Tablet).forceCurve.outMax, 1.0, 1e-9);
+    }
+    if (data.getChildFile("v1-first-release.state").existsAsFile()) {
+        // The first release had no articulations, mute or automatic vibrato: they come back at
+        // their defaults, not at whatever this instance had.
+        RosinProcessor p;
+        setChoice(p, "articulation", 5);
+        setChoice(p, "mute", 1);
+        const auto s = rosinStateOf(data.getChildFile("v1-first-release.state"));
+        p.setStateInformation(s.getData(), static_cast<int>(s.getSize()));
+        EXPECT_EQ(p.lastStateProblem(), "");
+        EXPECT_FLOAT_EQ(raw(p, "articulation"), 0.0f);
+        EXPECT_FLOAT_EQ(raw(p, "mute"), 0.0f);
+        EXPECT_FLOAT_EQ(raw(p, "vibrato_auto"), 0.0f);
+    } else {
+        ADD_FAILURE() << "tests/data/state/v1-first-release.state is missing";
+    }
+}
+
+TEST(ProcessorState, AStateFromANewerBuildIsRefusedWithAReason)
+{
+    juce::ScopedJuceInitialiser_GUI juce;
+    RosinProcessor p;
+    setChoice(p, "articulation", 2);
+    const auto s = rosinStateOf(juce::File(ROSIN_TEST_DATA "/state").getChildFile("v9-from-a-newer-build.state"));
+    p.setStateInformation(s.getData(), static_cast<int>(s.getSize()));
+    EXPECT_NE(p.lastStateProblem().indexOf("newer Rosin"), -1) << p.lastStateProblem();
+    EXPECT_FLOAT_EQ(raw(p, "articulation"), 2.0f); // untouched
+    const char garbage[] = "not a state at all";
+    p.setStateInformation(garbage, sizeof garbage);
+    EXPECT_NE(p.lastStateProblem().indexOf("not a Rosin state"), -1) << p.lastStateProblem();
+}
+
+TEST(ProcessorParameters, AChoiceAddedLaterDoesNotMoveAutomation)
+{
+    // Hosts store choices as normalised values. Each growing choice has spare slots, so the
+    // normalised value of every existing choice is fixed by its slot count, not by how many
+    // choices exist today.
+    juce::ScopedJuceInitialiser_GUI juce;
+    RosinProcessor p;
+    const std::pair<const char*, int> slots[] = {{"articulation", 16}, {"friction_model", 8}, {"contact_law", 4}, {"string_policy", 4}, {"fixed_string", 8}};
+    for (const auto& [id, n] : slots) {
+        auto* param = dynamic_cast<juce::AudioParameterChoice*>(p.parameters().getParameter(id));
+        ASSERT_NE(param, nullptr) << id;
+        EXPECT_EQ(param->choices.size(), n) << id;
+        const int real = static_cast<int>(engine::choiceNames(static_cast<engine::Param>(engine::paramIndex(id))).size());
+        for (int i = 0; i < real; ++i) EXPECT_FLOAT_EQ(param->convertTo0to1(static_cast<float>(i)), static_cast<float>(i) / (n - 1)) << id;
+        // A spare slot plays the last real choice.
+        param->setValueNotifyingHost(1.0f);
+        const auto which = static_cast<engine::Param>(engine::paramIndex(id));
+        EXPECT_FLOAT_EQ(engine::sanitise(which, p.currentParams()[static_cast<std::size_t>(which)]), engine::paramInfo(which).max) << id;
+    }
+    EXPECT_EQ(engine::choiceNames(engine::Param::Articulation).size(), 7u); // the README lists these seven
+}
+
+// Every cross-thread path of the processor at once (the `tsan` build runs this under
+// ThreadSanitizer): the audio thread plays, in real-time and offline mode, while the message
+// thread restores states of other instruments, loads maps, arms MIDI-learn and moves
+// parameters, the housekeeping thread builds and frees engines, and the HID thread plays a pen.
+TEST(ProcessorThreads, StatesMapsLearnAndEnginesChangeWhileAudioRuns)
+{
+    juce::ScopedJuceInitialiser_GUI juce;
+    std::atomic<bool> plugged{true};
+    std::atomic<int> sent{0};
+    RosinProcessor p;
+    p.setPlayConfigDetails(0, 2, 48000.0, 256);
+    p.prepareToPlay(48000.0, 256);
+    ASSERT_TRUE(p.hidInput().setBackend(std::make_unique<FakeBackend>(
+        rosin::hid::readBinary(ROSIN_HID_DATA "/huion_h640p_256c_006d_pen.rdesc.bin"), plugged, sent)));
+    p.hidInput().rescanSeconds = 0.01;
+    std::vector<juce::MemoryBlock> states(4);
+    for (int i = 0; i < 4; ++i) {
+        setChoice(p, "instrument", i);
+        p.getStateInformation(states[static_cast<std::size_t>(i)]);
+    }
+    std::atomic<bool> done{false};
+    std::atomic<long> blocksDone{0};
+    std::atomic<bool> finite{true};
+    std::thread audio([&] {
+        juce::AudioBuffer<float> buffer(2, 256);
+        int k = 0;
+        while (!done.load()) {
+            juce::MidiBuffer midi;
+            midi.addEvent(juce::MidiMessage::noteOn(1 + k % 3, 40 + k % 30, 0.7f), 3);
+            midi.addEvent(juce::MidiMessage::controllerEvent(1, 21, k % 128), 100);
+            midi.addEvent(juce::MidiMessage::noteOff(1 + (k + 1) % 3, 40 + (k + 15) % 30), 200);
+            p.setNonRealtime(k % 50 < 10);
+            buffer.clear();
+            p.processBlock(buffer, midi);
+            for (int i = 0; i < 256; ++i)
+                if (!std::isfinite(buffer.getSample(0, i))) finite = false;
+            ++k;
+            blocksDone.fetch_add(1);
+        }
+    });
+    p.parameters().getParameter("hid_input")->setValueNotifyingHost(1.0f);
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+    for (int k = 0; std::chrono::steady_clock::now() < end; ++k) {
+        const auto& s = states[static_cast<std::size_t>(k % 4)];
+        p.setStateInformation(s.getData(), static_cast<int>(s.getSize()));
+        p.loadMapping(k % 2 ? "keyboard" : "mpe");
+        p.controllerMap().armLearn(static_cast<int>(engine::Param::BowPosition));
+        p.parameters().getParameter("bow_force")->setValueNotifyingHost(static_cast<float>(k % 10) / 10.0f);
+        if (k % 5 == 0) p.loadInstrument(RosinProcessor::instrumentNames()[k % 4], true);
+        if (k % 7 == 0) plugged = !plugged.load();
+        std::this_thread::sleep_for(std::chrono::milliseconds(7));
+    }
+    done = true;
+    audio.join();
+    p.parameters().getParameter("hid_input")->setValueNotifyingHost(0.0f);
+    EXPECT_TRUE(finite.load());
+    EXPECT_GT(blocksDone.load(), 100);
+    EXPECT_GT(p.enginesInstalled(), 5);
+}
