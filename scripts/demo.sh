@@ -7,7 +7,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
 mkdir -p out
-./build/lab/rosin render --midi presets/midi/demo-phrase.mid --preset cello --out out/demo-phrase.wav
+./build/plugin/rosin-host render --midi presets/midi/demo-phrase.mid --preset cello --out out/demo-phrase.wav
 # One short phrase per articulation (keyswitches choose them; legato and the mute are parameters).
 mkdir -p out/articulations
 for f in presets/midi/articulations/*.mid; do
@@ -15,7 +15,7 @@ for f in presets/midi/articulations/*.mid; do
   case "$name" in
     legato) ./build/plugin/rosin-host render --plugin build/plugin/RosinPlugin_artefacts/Release/VST3/Rosin.vst3 \
               --midi "$f" --preset violin --set legato=@1 --out "out/articulations/$name.wav" ;;
-    *) ./build/lab/rosin render --midi "$f" --preset violin --out "out/articulations/$name.wav" ;;
+    *) ./build/plugin/rosin-host render --midi "$f" --preset violin --out "out/articulations/$name.wav" ;;
   esac
 done
 ./build/plugin/rosin-host render --plugin build/plugin/RosinPlugin_artefacts/Release/VST3/Rosin.vst3 \

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -63,6 +64,21 @@ std::string auditText(const rosin::host::audit::Tally& t)
            std::to_string(t.waits) + " condition/semaphore calls, " + std::to_string(t.blocking) + " blocking calls";
 }
 
+/// The Rosin VST3 next to this program (the build tree's layout), else the user's ~/.vst3 one.
+std::string defaultBundle()
+{
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec)
+        for (const char* config : {"Release", "RelWithDebInfo", "Debug"}) {
+            const fs::path built = self.parent_path() / "RosinPlugin_artefacts" / config / "VST3" / "Rosin.vst3";
+            if (fs::exists(built)) return built.string();
+        }
+    if (const char* home = std::getenv("HOME"); home && fs::exists(fs::path(home) / ".vst3" / "Rosin.vst3"))
+        return (fs::path(home) / ".vst3" / "Rosin.vst3").string();
+    throw std::runtime_error("no Rosin.vst3 beside rosin-host or in ~/.vst3: give --plugin");
+}
+
 std::vector<char> readBytes(const fs::path& file)
 {
     std::ifstream in(file, std::ios::binary);
@@ -83,7 +99,7 @@ int main(int argc, char** argv)
     int block = 512;
     bool audit = false;
     std::vector<std::string> sets;
-    render->add_option("--plugin", plugin, "the built plugin bundle (.vst3 or .lv2)")->required();
+    render->add_option("--plugin", plugin, "the plugin bundle (.vst3 or .lv2); default: the Rosin.vst3 built beside this program, else ~/.vst3/Rosin.vst3");
     render->add_option("--out", out, "WAV file to write (32-bit float, stereo)")->required();
     render->add_option("--midi", midiFile, "standard MIDI file (type 0 or 1)");
     render->add_option("--events", eventsFile, "event list: 'seconds hexbytes...' per line");
@@ -195,6 +211,7 @@ int main(int argc, char** argv)
             return 1;
         }
     }
+    if (plugin.empty()) plugin = defaultBundle();
     try {
         PluginHost host(plugin);
         if (presetsCmd->parsed()) {

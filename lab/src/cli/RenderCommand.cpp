@@ -2,8 +2,6 @@
 #include "Cli.h"
 
 #include <sndfile.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -90,46 +88,6 @@ int runRender(const ModelOptions& m, const std::string& gestureName, const Gestu
     return 0;
 }
 
-/// `rosin render --midi`: the instrument plays the file. The plugin is the instrument, so the
-/// render goes through the headless host loading the built plugin (the same code a DAW runs).
-int runMidiRender(const std::string& midi, const std::string& preset, const std::string& plugin, double sampleRate,
-                  const std::string& out, bool quiet)
-{
-    std::vector<fs::path> hosts;
-    std::error_code ec;
-    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec) hosts.push_back(self.parent_path() / "rosin-host");
-#ifdef ROSIN_HOST_EXE
-    hosts.emplace_back(ROSIN_HOST_EXE);
-#endif
-    fs::path host;
-    for (const auto& h : hosts)
-        if (fs::exists(h)) { host = h; break; }
-    if (host.empty())
-        throw LabError("--midi needs the instrument: build with -DROSIN_BUILD_PLUGIN=ON (scripts/build.sh does) so "
-                       "rosin-host and the Rosin plugin exist");
-    std::string bundle = plugin;
-#ifdef ROSIN_VST3_BUNDLE
-    if (bundle.empty()) bundle = ROSIN_VST3_BUNDLE;
-#endif
-    if (bundle.empty() || !fs::exists(bundle)) throw LabError("--plugin: no plugin bundle at '" + bundle + "'");
-    if (!fs::exists(midi)) throw LabError("--midi " + midi + ": no such file");
-    const std::string wav = fs::path(out).extension() == ".wav" ? out : out + ".wav";
-    std::vector<std::string> args{host.string(), "render", "--plugin", bundle, "--midi", midi, "--out", wav,
-                                  "--rate", std::to_string(static_cast<long long>(std::llround(sampleRate))), "--preset", preset};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    if (posix_spawn(&pid, host.c_str(), nullptr, nullptr, argv.data(), environ) != 0)
-        throw LabError("cannot start " + host.string());
-    int status = 0;
-    waitpid(pid, &status, 0);
-    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
-    if (code == 0 && !quiet) std::printf("wrote %s\n", wav.c_str());
-    return code;
-}
-
 } // namespace
 
 namespace {
@@ -141,7 +99,6 @@ struct RenderCommand {
     Gesture gesture;
     double duration = 0.0, sampleRate = 192000.0;
     bool noCsv = false, listen = false, quiet = false, views = false;
-    std::string midi, preset = "cello", plugin;
     CLI::Option* rateOption = nullptr;
 
     CLI::App* add(CLI::App& app)
@@ -159,9 +116,8 @@ struct RenderCommand {
             "--listen) and OUT.csv (time_s, bridge_force_N, bow_point_velocity_m_s, friction_force_N,\n"
             "contact_temperature_C, temperature_rise_K, stick, bow_force_N, bow_speed_m_s, beta).\n"
             "Nothing is written unless the whole render succeeds.\n"
-            "With --midi FILE the instrument plays a MIDI file instead: the built plugin (VST3 by\n"
-            "default) runs in the headless host at --sample-rate and writes OUT (.wav added) in stereo,\n"
-            "e.g. rosin render --midi song.mid --preset cello --out song.wav --sample-rate 48000");
+            "A MIDI file is played by the instrument (the plugin) in its headless host:\n"
+            "  rosin-host render --midi song.mid --preset cello --out song.wav");
         renderModel.add(renderCmd);
         renderCmd->add_option("--gesture", gestureName, "guettler, constant, exp-speed, exp-force or file")
             ->check(CLI::IsMember({"guettler", "constant", "exp-speed", "exp-force", "file"}))
@@ -188,18 +144,11 @@ struct RenderCommand {
                                               "temperature, friction loop, Schelleng map) to OUT-views.png, data in OUT-views.json");
         renderCmd->add_flag("--listen", listen, "Normalised 24-bit WAV for listening instead of newtons");
         renderCmd->add_flag("-q,--quiet", quiet, "No progress and no summary");
-        renderCmd->add_option("--midi", midi, "Play this MIDI file on the instrument (plugin) instead of one gesture");
-        renderCmd->add_option("--preset", preset, "Instrument for --midi: violin, viola, cello or double-bass")
-            ->check(CLI::IsMember({"violin", "viola", "cello", "double-bass"}))
-            ->capture_default_str();
-        renderCmd->add_option("--plugin", plugin, "Plugin bundle for --midi (default: the built Rosin.vst3)");
         return renderCmd;
     }
 
     int run()
     {
-        // Music defaults to 48 kHz; the 192 kHz research default is for single gestures.
-        if (!midi.empty()) return runMidiRender(midi, preset, plugin, rateOption->count() ? sampleRate : 48000.0, out, quiet);
         return runRender(renderModel, gestureName, gesture, gestureFile, duration, sampleRate, out, noCsv, listen, quiet, views);
     }
 };

@@ -412,22 +412,35 @@ void Synth::render(float* left, float* right, int numSamples) noexcept
             }
             if (!v.active() && tapVoice_ == &v) tapVoice_ = nullptr;
         }
+        // Gain and body mix glide only while they move; settled, they are constants of the chunk.
+        const bool gliding = gain_ != gainTarget_ || bodyMix_ != bodyTarget;
+        float mix = static_cast<float>(bodyMix_), g = static_cast<float>(gain_);
+        bool finite = true;
         for (int i = 0; i < n; ++i) {
-            gain_ += (gainTarget_ - gain_) * smoothing_;
-            bodyMix_ += (bodyTarget - bodyMix_) * smoothing_;
-            const float mix = static_cast<float>(bodyMix_), g = static_cast<float>(gain_);
+            if (gliding) {
+                gain_ += (gainTarget_ - gain_) * smoothing_;
+                bodyMix_ += (bodyTarget - bodyMix_) * smoothing_;
+                if (std::abs(gain_ - gainTarget_) < 1e-7 * gainTarget_) gain_ = gainTarget_;
+                if (std::abs(bodyMix_ - bodyTarget) < 1e-7) bodyMix_ = bodyTarget;
+                mix = static_cast<float>(bodyMix_);
+                g = static_cast<float>(gain_);
+            }
             const float l = busL_[static_cast<std::size_t>(i)], r = busR_[static_cast<std::size_t>(i)];
             const float bl = body_[0].processSample(l), br = body_[1].processSample(r);
-            float outL = g * (mix * bl + (1.0f - mix) * direct * l);
-            float outR = g * (mix * br + (1.0f - mix) * direct * r);
-            // Last line of defence: whatever went wrong upstream, the host gets no NaN or a blast.
-            if (!std::isfinite(outL) || !std::isfinite(outR)) {
-                outL = outR = 0.0f;
-                body_[0].reset();
-                body_[1].reset();
-            }
+            const float outL = g * (mix * bl + (1.0f - mix) * direct * l);
+            const float outR = g * (mix * br + (1.0f - mix) * direct * r);
             left[start + i] = std::clamp(outL, -4.0f, 4.0f);
             right[start + i] = std::clamp(outR, -4.0f, 4.0f);
+            finite = finite && std::isfinite(outL + outR);
+        }
+        // Last line of defence: whatever went wrong upstream, the host gets no NaN or a blast.
+        if (!finite) {
+            for (int i = 0; i < n; ++i) {
+                if (!std::isfinite(left[start + i])) left[start + i] = 0.0f;
+                if (!std::isfinite(right[start + i])) right[start + i] = 0.0f;
+            }
+            body_[0].reset();
+            body_[1].reset();
         }
     }
 }

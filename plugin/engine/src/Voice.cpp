@@ -137,7 +137,10 @@ void Voice::updateControl(const VoiceContext& ctx) noexcept
     const BowTarget t = mapBow(params, (*ctx.stringScale)[static_cast<std::size_t>(string_)], force01, speed, c.position);
     targetForce_ = c.direct && !c.engaged ? 0.0 : t.force;
     targetSpeed_ = t.speed;
+    // The bow point glides to its target; once there it stops moving (the waveguide redesigns its
+    // taps whenever beta changes, so an endless creep of 1e-9 would cost that every control tick).
     beta_ += (t.beta - beta_) * ctx.betaSmoothing;
+    if (std::abs(t.beta - beta_) < 1e-6 * t.beta) beta_ = t.beta;
     volume_ = c.volume;
     liftStep_ = 1.0 / (ctx.sampleRate * std::max(0.005, static_cast<double>(params[index(Param::ReleaseTime)])));
 
@@ -284,24 +287,31 @@ void Voice::processBlock(float* busL, float* busR, int n, const VoiceContext& ct
             reset();
             return;
         }
-        for (int k = 0; k < m; ++k) {
-            const bool bowOff = (stick[k] & 2) != 0;
-            stick[k] &= 1;
-            listen(stick[k] != 0);
-            if (stolen_) fade_ *= ctx.stealCoefficient;
-            else if (released_ && bowOff) fade_ *= ctx.ringCoefficient;
-            const float y = static_cast<float>(out[k] * fade_);
-            if (taps && taps->bridge && taps->count < taps->capacity) {
+        if (taps && taps->bridge)
+            for (int k = 0; k < m && taps->count < taps->capacity; ++k, ++taps->count) {
                 taps->bridge[taps->count] = out[k];
-                if (taps->stick) taps->stick[taps->count] = stick[k];
-                ++taps->count;
+                if (taps->stick) taps->stick[taps->count] = stick[k] & 1;
             }
-            busL[i + k] += gl * y;
-            busR[i + k] += gr * y;
-            if ((stolen_ || (released_ && bowOff)) && fade_ < silence) {
-                active_ = false;
-                strings_[static_cast<std::size_t>(string_)].reset();
-                break;
+        if (!released_) { // held: no fade, the common case
+            for (int k = 0; k < m; ++k) {
+                listen((stick[k] & 1) != 0);
+                busL[i + k] += gl * out[k];
+                busR[i + k] += gr * out[k];
+            }
+        } else {
+            for (int k = 0; k < m; ++k) {
+                const bool bowOff = (stick[k] & 2) != 0;
+                listen((stick[k] & 1) != 0);
+                if (stolen_) fade_ *= ctx.stealCoefficient;
+                else if (bowOff) fade_ *= ctx.ringCoefficient;
+                const float y = static_cast<float>(out[k] * fade_);
+                busL[i + k] += gl * y;
+                busR[i + k] += gr * y;
+                if ((stolen_ || bowOff) && fade_ < silence) {
+                    active_ = false;
+                    strings_[static_cast<std::size_t>(string_)].reset();
+                    break;
+                }
             }
         }
         i += m;

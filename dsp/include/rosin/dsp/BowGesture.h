@@ -37,7 +37,13 @@ struct GestureFrame {
 
 class BowGesture {
 public:
-    void prepare(double sampleRate) noexcept { dt_ = 1.0 / sampleRate; }
+    void prepare(double sampleRate) noexcept
+    {
+        dt_ = 1.0 / sampleRate;
+        // Per-sample smoothing factors, computed once: the audio loop calls no exp.
+        settle10ms_ = 1.0 - std::exp(-dt_ / 0.01);
+        boostDecay_ = std::exp(-dt_ / 0.08);
+    }
 
     /// A note starts. direction +1 down / -1 up; bowPosition = where on the bow (m from the frog).
     void start(Articulation a, double velocity, const GestureSettings& s, int direction, double bowPosition) noexcept
@@ -89,7 +95,7 @@ public:
                 force_ = aim.force * settings_.marteleBite;
                 speedMag_ = 0.0;
             } else if (t_ < bite + stroke) { // released into a fast stroke
-                force_ += (0.6 * aim.force - force_) * (1.0 - std::exp(-dt / 0.01));
+                force_ += (0.6 * aim.force - force_) * settle10ms_;
                 speedMag_ = std::min(2.5 * aim.speed, speedMag_ + 20.0 * dt);
             } else { // the bow stops on the string
                 speedMag_ = std::max(0.0, speedMag_ - 2.5 * aim.speed * dt / 0.03);
@@ -123,8 +129,8 @@ public:
         case Articulation::Harmonic: // bowed like detache; the left hand makes the harmonic
         default: {
             if (speedMag_ < aim.speed) speedMag_ = std::min(aim.speed, speedMag_ + settings_.acceleration * std::max(0.05, velocity_) * dt);
-            else speedMag_ += (aim.speed - speedMag_) * (1.0 - std::exp(-dt / 0.01));
-            boost_ *= std::exp(-dt / 0.08);
+            else speedMag_ += (aim.speed - speedMag_) * settle10ms_;
+            boost_ *= boostDecay_;
             // Harmonics speak with a lighter bow (the touched string has less to hold).
             const double light = articulation_ == Articulation::Harmonic ? 0.5 : 1.0;
             force_ = aim.force * light * (1.0 + boost_);
@@ -159,7 +165,7 @@ private:
 
     GestureSettings settings_;
     Articulation articulation_ = Articulation::Detache;
-    double dt_ = 1.0 / 48000.0, t_ = 0.0, velocity_ = 0.0, position_ = 0.0, speedMag_ = 0.0, force_ = 0.0;
+    double dt_ = 1.0 / 48000.0, settle10ms_ = 1.0 - std::exp(-1.0 / 480.0), boostDecay_ = std::exp(-1.0 / 3840.0), t_ = 0.0, velocity_ = 0.0, position_ = 0.0, speedMag_ = 0.0, force_ = 0.0;
     double lift_ = 1.0, boost_ = 0.0, changing_ = 0.0, changeLeft_ = 0.0, strokeClock_ = 0.0;
     int direction_ = 1;
     bool released_ = false;
