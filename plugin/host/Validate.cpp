@@ -203,6 +203,10 @@ int validate(const std::filesystem::path& plugin, const ValidateOptions& o, std:
         });
         done = true;
         automation.join();
+        // Moves made after the last block wait in JUCE's hosting layer and reach the plugin with
+        // the next block, whatever happened in between: deliver them now, so that they do not
+        // land on top of the state the next check restores.
+        play(h, 48000.0, 128, 0.01, false, s, nullptr);
         h.stopStream();
         const audit::Counts c = audit::read();
         check.report(s.nonFinite == 0 && s.peak <= outputBound && c.plugin.total() == 0, "parameters random-walked from another thread",

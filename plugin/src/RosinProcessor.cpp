@@ -388,8 +388,8 @@ void RosinProcessor::hidEvents(int numSamples) noexcept
         e.channel = 0;
         switch (h.kind) {
         case hid::Event::Kind::Bow:
-            for (const auto& [kind, value] : {std::pair{Control::Force, h.force}, std::pair{Control::DirectSpeed, h.speed},
-                                              std::pair{Control::Position, h.position}, std::pair{Control::StringChoice, static_cast<float>(h.string)},
+            for (const auto& [kind, value] : {std::pair{Control::DirectForce, h.force}, std::pair{Control::DirectSpeed, h.speed},
+                                              std::pair{Control::DirectPosition, h.position}, std::pair{Control::StringChoice, static_cast<float>(h.string)},
                                               std::pair{Control::Engage, h.engaged ? 1.0f : 0.0f}}) {
                 e.kind = kind;
                 e.value = value;

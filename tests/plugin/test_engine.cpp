@@ -423,8 +423,8 @@ TEST(EngineDirectBow, AControllersHandHoldsTheBowThroughTheSameMapping)
     const double nominalBeta = p[static_cast<int>(Param::BowPosition)];
     const double gScale = stringForceScale(s->instrument(), 1);
     ASSERT_GT(std::abs(gScale - 1.0), 0.05); // the G string is heavier than the D: the scaling shows
-    for (const auto& e : {control(Control::StringChoice, 1.0f), control(Control::Force, 0.6f), control(Control::DirectSpeed, 0.7f),
-                          control(Control::Position, 0.7f), control(Control::Engage, 1.0f)})
+    for (const auto& e : {control(Control::StringChoice, 1.0f), control(Control::DirectForce, 0.6f), control(Control::DirectSpeed, 0.7f),
+                          control(Control::DirectPosition, 0.7f), control(Control::Engage, 1.0f)})
         s->apply(e);
     const int fs = 48000;
     const auto down = mono(render(*s, fs / 2, {on(0, 50)}));
@@ -444,7 +444,7 @@ TEST(EngineDirectBow, AControllersHandHoldsTheBowThroughTheSameMapping)
     EXPECT_NEAR(s->voiceInfo(0).force, 0.0, 1e-3);
     // Absurd values reach the model clamped to its own limits, never as NaN.
     s->apply(control(Control::Engage, 1.0f));
-    s->apply(control(Control::Force, NAN));
+    s->apply(control(Control::DirectForce, NAN));
     s->apply(control(Control::DirectSpeed, INFINITY));
     const auto wild = mono(render(*s, fs / 10, {}));
     for (float x : wild) ASSERT_TRUE(std::isfinite(x));
@@ -462,12 +462,33 @@ TEST(EngineDirectBow, MidiPressureAndAControllerReachTheSameForce)
     p[static_cast<int>(Param::AttackForce)] = 0.0f;
     auto midi = makeSynth("cello", 48000.0, p), hid = makeSynth("cello", 48000.0, p);
     render(*midi, 24000, {cc(0, 2, 90), on(1, 50)});
-    hid->apply(control(Control::Force, 90.0f / 127.0f));
+    hid->apply(control(Control::DirectForce, 90.0f / 127.0f));
     hid->apply(control(Control::DirectSpeed, 0.5f));
     hid->apply(control(Control::Engage, 1.0f));
     render(*hid, 24000, {on(1, 50)});
     EXPECT_NEAR(midi->voiceInfo(0).force, hid->voiceInfo(0).force, 1e-4);
     EXPECT_NEAR(midi->voiceInfo(0).force, 2.0 * 90.0 / 127.0 * p[static_cast<int>(Param::BowForce)], 1e-3);
+}
+
+// A tablet put down (pen lifted at zero pressure, then released) must not leave its force and
+// position on the channel: the keyboard played next gets its own CC2 and CC74 back.
+TEST(EngineDirectBow, AKeyboardAfterTheTabletPlaysWithItsOwnControls)
+{
+    ParamValues p = defaultParams();
+    p[static_cast<int>(Param::AttackForce)] = 0.0f;
+    auto s = makeSynth("cello", 48000.0, p);
+    const int fs = 48000;
+    render(*s, fs / 10, {cc(0, 2, 80), cc(0, 74, 40)});
+    for (const auto& e : {control(Control::DirectForce, 0.0f), control(Control::DirectSpeed, 0.5f), control(Control::DirectPosition, 1.0f),
+                          control(Control::Engage, 0.0f), control(Control::DirectRelease, 0.0f)})
+        s->apply(e);
+    const auto keyboard = mono(render(*s, fs / 2, {on(0, 50)}));
+    const VoiceInfo v = s->voiceInfo(0);
+    const double nominalForce = s->parameters()[static_cast<int>(Param::BowForce)];
+    const double nominalBeta = s->parameters()[static_cast<int>(Param::BowPosition)];
+    EXPECT_NEAR(v.force, 2.0 * 80.0 / 127.0 * nominalForce * stringForceScale(s->instrument(), v.stringIndex), 1e-3);
+    EXPECT_NEAR(v.beta, nominalBeta * std::exp2(2.0 * (40.0 / 127.0 - 0.5)), 1e-3);
+    EXPECT_GT(test::rms(keyboard, fs / 4, fs / 2), 1e-2);
 }
 
 // The editor's live views: the newest note writes its physics, sample by sample, into the ring

@@ -48,6 +48,8 @@ Performance::Channel Performance::effective(int c) const noexcept
         e.direct = true;
         e.engaged = m.engaged;
         e.directSpeed = m.directSpeed;
+        e.directForce = m.directForce;
+        e.directPosition = m.directPosition;
         e.preferredString = m.preferredString;
     }
     return e;
@@ -123,8 +125,11 @@ void Performance::apply(const ControlEvent& e) noexcept
     case Control::DirectRelease:
         ch.direct = ch.engaged = false;
         ch.directSpeed = 0.0f;
+        ch.directForce = ch.directPosition = -1.0f;
         ch.preferredString = -1;
         break;
+    case Control::DirectForce: ch.directForce = std::clamp(v, 0.0f, 1.0f); break;
+    case Control::DirectPosition: ch.directPosition = std::clamp(v, 0.0f, 1.0f); break;
     case Control::StringChoice: ch.preferredString = v >= 0.0f ? static_cast<int>(v) : -1; break;
     case Control::SoundOff:
     case Control::NotesOff: removeHeld(c, -1); break;
@@ -135,6 +140,8 @@ void Performance::apply(const ControlEvent& e) noexcept
         ch.direct = kept.direct;
         ch.engaged = kept.engaged;
         ch.directSpeed = kept.directSpeed;
+        ch.directForce = kept.directForce;
+        ch.directPosition = kept.directPosition;
         ch.preferredString = kept.preferredString;
         releaseSustained(c);
         break;

@@ -132,9 +132,10 @@ void Voice::updateControl(const VoiceContext& ctx) noexcept
     direct_ = c.direct;
     engaged_ = c.engaged;
     // The one mapping from normalised controls to the model's units (Controls.h).
-    const float force01 = polyPressure_ >= 0.0f ? polyPressure_ : c.force;
+    const float force01 = polyPressure_ >= 0.0f ? polyPressure_ : c.direct && c.directForce >= 0.0f ? c.directForce : c.force;
     const float speed = c.direct ? c.directSpeed : (c.speed >= 0.0f ? c.speed : 0.5f);
-    const BowTarget t = mapBow(params, (*ctx.stringScale)[static_cast<std::size_t>(string_)], force01, speed, c.position);
+    const float position01 = c.direct && c.directPosition >= 0.0f ? c.directPosition : c.position;
+    const BowTarget t = mapBow(params, (*ctx.stringScale)[static_cast<std::size_t>(string_)], force01, speed, position01);
     targetForce_ = c.direct && !c.engaged ? 0.0 : t.force;
     targetSpeed_ = t.speed;
     // The bow point glides to its target; once there it stops moving (the waveguide redesigns its

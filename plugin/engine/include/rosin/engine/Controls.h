@@ -23,6 +23,8 @@ enum class Control : std::uint8_t {
     DirectSpeed,  ///< a controller's hand holds the bow: signed -1..1, 0.5 = nominal, sign = direction
     Engage,       ///< a held bow touches the string (1) or not (0)
     DirectRelease,///< the controller has let go of the bow: the virtual player bows again
+    DirectForce,  ///< 0..1 like Force, from the controller that holds the bow; forgotten when it lets go
+    DirectPosition,///< 0..1 like Position, from the controller that holds the bow; forgotten when it lets go
     StringChoice, ///< value = the string new notes on this channel prefer (0 = lowest), -1 none
     Parameter,    ///< host parameter `index` takes `value` in its own units (a learned controller, a keyswitch)
     Learned,      ///< a MIDI-learn completed: controller `note` now drives parameter `index`

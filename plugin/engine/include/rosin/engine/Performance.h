@@ -22,6 +22,9 @@ public:
         bool sustain = false;
         bool direct = false, engaged = false; ///< a controller holds the bow; it touches the string
         float directSpeed = 0.0f;             ///< -1..1, signed
+        /// The holding controller's force and position, kept apart from the channel's (CC2, CC74)
+        /// so that a keyboard played after the tablet is put down gets its own values back.
+        float directForce = -1.0f, directPosition = -1.0f;
         int preferredString = -1;             ///< string chosen by a controller, -1 none
     };
     struct Held {
