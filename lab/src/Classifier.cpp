@@ -178,6 +178,27 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
             hi = bestT0 + span;
         }
     }
+    // The sensor's offset is what it reads while the string rests before the gesture. Where the
+    // recording holds a millisecond of that rest, the offset comes from it, and the ramp's gain is
+    // refitted with it fixed: the ramp's intercept alone took a false DC out of clean data
+    // (the quasi-static ramp is not the string's exact start).
+    const int rest = static_cast<int>(best.trigger * fs) - static_cast<int>(0.2e-3 * fs);
+    if (!best.humWave.empty() && rest >= static_cast<int>(1e-3 * fs)) {
+        std::vector<double> still(static_cast<std::size_t>(rest));
+        for (int i = 0; i < rest; ++i) still[static_cast<std::size_t>(i)] = f[static_cast<std::size_t>(i)] - best.humWave[static_cast<std::size_t>(i)];
+        std::nth_element(still.begin(), still.begin() + rest / 2, still.end());
+        best.dc = still[static_cast<std::size_t>(rest / 2)];
+        if (in.knownGain <= 0.0) {
+            const auto xb = bowDisplacement(in.bowSpeed, fs, end, best.trigger);
+            double num = 0.0, den = 0.0;
+            for (int i = 0; i < end; ++i) {
+                const double ramp = stiffness * xb[static_cast<std::size_t>(i)];
+                num += ramp * (f[static_cast<std::size_t>(i)] - best.dc - best.humWave[static_cast<std::size_t>(i)]);
+                den += ramp * ramp;
+            }
+            if (den > 0.0 && num > 0.0) best.gain = num / den;
+        }
+    }
     return best;
 }
 

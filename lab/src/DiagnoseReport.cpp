@@ -150,7 +150,14 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     for (const auto& f : d.findings) {
         json params = json::object();
         for (const auto& [name, v] : f.parameters) {
-            params[name] = {{"value", v[0]}, {"ci95", {v[1], v[2]}}};
+            // ci95 is the reported interval: it spans both estimates (a direction either one finds
+            // loose stays loose); each is given on its own beside it.
+            double lo = v[1], hi = v[2];
+            if (f.curvature.count(name)) {
+                lo = std::min(lo, f.curvature.at(name)[0]);
+                hi = std::max(hi, f.curvature.at(name)[1]);
+            }
+            params[name] = {{"value", v[0]}, {"ci95", {lo, hi}}, {"ci95_bootstrap", {v[1], v[2]}}};
             if (f.curvature.count(name)) params[name]["ci95_curvature"] = f.curvature.at(name);
         }
         findings.push_back({{"effect", f.effect}, {"evidence", f.evidence}, {"parameters", params},
