@@ -1,22 +1,56 @@
 #!/usr/bin/env bash
-# Fuzz the HID descriptor parser, report decoder and bow mapper with libFuzzer (clang) under
-# AddressSanitizer and UBSan. Usage: scripts/fuzz.sh [seconds, default 20] [build dir].
-# CI runs it for 20 s (ctest, label hid); run it longer by hand: scripts/fuzz.sh 1800
+# Fuzz what reads bytes from outside with libFuzzer (clang) under AddressSanitizer and UBSan:
+#   hid      HID descriptor parser, report decoder and bow mapper, with every quirk set
+#   mapping  HidMapping::fromJson (controller files and the HID maps inside saved sessions)
+#   state    the plugin's state reader (what a host hands setStateInformation)
+# Usage: scripts/fuzz.sh [seconds per target, default 20] [build dir] [runs per target]
+# CI runs 20 s per target (ctest hid_fuzz_bounded); the long run (ctest label long,
+# hid_fuzz_long) asks for 10^6 executions of each. Exit status: non-zero on any crash.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
 out=$(realpath -m "${2:-build/fuzz}")
-mkdir -p "$out/corpus"
-src=plugin/hid
-clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-  -I "$src/include" -I plugin/rt/include -I presets/lib/include \
-  "$src/fuzz/FuzzHid.cpp" "$src/src/Descriptor.cpp" "$src/src/Mapping.cpp" presets/lib/src/Document.cpp -o "$out/fuzz-hid"
-# Seeds: every real descriptor, wrapped in the input format with one all-zero report.
+runs=${3:--1}
+mkdir -p "$out"
+flags=(-std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined)
+inc=(-I plugin/hid/include -I plugin/rt/include -I presets/lib/include -I plugin/engine/include -I dsp/include -I plugin/src)
+hid_src=(plugin/hid/src/Descriptor.cpp plugin/hid/src/Mapping.cpp plugin/hid/src/Devices.cpp presets/lib/src/Document.cpp)
+
+clang++ "${flags[@]}" "${inc[@]}" plugin/fuzz/FuzzHid.cpp "${hid_src[@]}" -o "$out/fuzz-hid"
+clang++ "${flags[@]}" "${inc[@]}" plugin/fuzz/FuzzMappingJson.cpp "${hid_src[@]}" -o "$out/fuzz-mapping"
+# juce_core once per build folder (about 40 s); the state reader needs nothing else of JUCE.
+juce=/usr/share/juce/modules
+if [[ ! -f "$out/juce_core.o" || "$juce/juce_core/juce_core.cpp" -nt "$out/juce_core.o" ]]; then
+  clang++ -std=c++20 -O1 -g -fsanitize=fuzzer-no-link,address,undefined -DJUCE_GLOBAL_MODULE_SETTINGS_INCLUDED=1 \
+    -DJUCE_STANDALONE_APPLICATION=1 -DJUCE_USE_CURL=0 -DNDEBUG=1 -I "$juce" -c "$juce/juce_core/juce_core.cpp" -o "$out/juce_core.o"
+fi
+clang++ "${flags[@]}" "${inc[@]}" -DJUCE_GLOBAL_MODULE_SETTINGS_INCLUDED=1 -DJUCE_STANDALONE_APPLICATION=1 -DNDEBUG=1 -I "$juce" \
+  plugin/fuzz/FuzzState.cpp plugin/src/StateFormat.cpp plugin/engine/src/Parameters.cpp "${hid_src[@]}" "$out/juce_core.o" \
+  -lz -lpthread -ldl -o "$out/fuzz-state"
+
+# Seeds: every real descriptor (with each device choice), the shipped controller maps, and the
+# saved states kept under tests/data/state (their inner XML).
+mkdir -p "$out/corpus-hid" "$out/corpus-mapping" "$out/corpus-state"
 for f in tests/data/hid/*.rdesc.bin; do
-  [[ -f "$f" ]] || continue
   n=$(stat -c %s "$f")
-  { printf "\\x$(printf %02x $((n & 255)))\\x$(printf %02x $((n >> 8)))"; cat "$f"; printf '\x08\x01\x00\x00\x00\x00\x00\x00\x00'; } \
-    > "$out/corpus/$(basename "$f").seed"
+  for choice in 0 1 10 13; do
+    { printf "\\x$(printf %02x $choice)\\x$(printf %02x $((n & 255)))\\x$(printf %02x $((n >> 8)))"; cat "$f"; printf '\x08\x01\x00\x00\x00\x00\x00\x00\x00'; } \
+      > "$out/corpus-hid/$(basename "$f").$choice.seed"
+  done
 done
-echo "fuzz: ${seconds}s on $(ls "$out/corpus" | wc -l) corpus files" >&2
-"$out/fuzz-hid" -max_total_time="$seconds" -max_len=4200 -timeout=10 -print_final_stats=1 "$out/corpus" 2>&1 | tail -15
+cp presets/controllers/*.json "$out/corpus-mapping/"
+for f in tests/data/state/*.state; do
+  { printf '\x01'; python3 tests/data/state/juce-state.py "$f"; } > "$out/corpus-state/$(basename "$f").seed"
+done
+
+status=0
+for target in hid mapping state; do
+  log="$out/fuzz-$target.log"
+  if "$out/fuzz-$target" -max_total_time="$seconds" -runs="$runs" -max_len=4200 -timeout=10 -artifact_prefix="$out/$target-" -print_final_stats=1 \
+       "$out/corpus-$target" > "$log" 2>&1; then
+    echo "fuzz $target: $(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$') executions, 0 crashes"
+  else
+    echo "fuzz $target: FAILED (see $log)"; tail -30 "$log"; status=1
+  fi
+done
+exit $status

@@ -245,7 +245,17 @@ void RosinEditor::timerCallback()
 void RosinEditor::refreshStatus()
 {
     juce::String text = processor_.currentInstrument() + ", " + juce::String(processor_.activeVoices()) + " voices sounding\nHID: " +
-                        juce::String(processor_.hidInput().status()) + "\nLearned: ";
+                        juce::String(processor_.hidInput().status()) + (processor_.hidInput().hotplug() ? " (hot-plug)" : "") + "\n";
+    // Per device: what it is, and what stands in the way (for a missing permission, the line
+    // to add to /etc/udev/rules.d/70-rosin-hid.rules).
+    for (const auto& d : processor_.hidInput().devices()) {
+        if (d.state == hid::DeviceStatus::State::Unsupported || d.state == hid::DeviceStatus::State::NotABow) continue;
+        text << "  " << juce::String(d.name) << ": " << hid::stateName(d.state);
+        if (!d.kind.empty()) text << " (" << juce::String(d.kind) << ")";
+        if (!d.detail.empty()) text << juce::String::fromUTF8(" \u2014 ") << juce::String(d.detail).trim().fromLastOccurrenceOf("\n", false, false);
+        text << "\n";
+    }
+    text << "Learned: ";
     const auto entries = processor_.controllerMap().entries();
     if (entries.empty()) text << "none";
     for (const auto& e : entries) {

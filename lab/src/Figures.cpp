@@ -127,7 +127,7 @@ SweepResult readSweepJson(const std::filesystem::path& file)
     json doc;
     try {
         doc = json::parse(in);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {
         throw LabError(file.string() + ": not valid JSON (" + e.what() + ")");
     }
     if (doc.value("format", "") != "rosin-guettler/1") throw LabError(file.string() + ": field 'format' must be \"rosin-guettler/1\"");

@@ -162,7 +162,7 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
     json doc;
     try {
         doc = json::parse(in);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {
         throw LabError(manifest.string() + ": not valid JSON (" + e.what() + ")");
     }
     if (!doc.is_object() || doc.value("format", "") != "rosin-measurement/1")

@@ -152,32 +152,39 @@ int main(int argc, char** argv)
                                              "the bow the first controller plays (no plugin needed)");
     double hidSeconds = 0.0;
     hidCmd->add_option("--seconds", hidSeconds, "watch the controller this long")->check(CLI::Range(0.0, 3600.0));
+    bool udevRulesOnly = false, supportedOnly = false;
+    hidCmd->add_flag("--udev-rules", udevRulesOnly, "print the udev rules file for the supported controllers (one line per product)");
+    hidCmd->add_flag("--supported", supportedOnly, "list the controllers Rosin knows by vendor and product id");
 
     CLI11_PARSE(app, argc, argv);
     if (hidCmd->parsed()) {
         using namespace rosin::hid;
-        auto backend = makeHidapiBackend();
-        const auto devices = backend->enumerate();
-        if (devices.empty()) std::printf("no HID devices (hidraw) found\n");
-        int playable = 0;
-        for (const auto& d : devices) {
-            std::string error, verdict;
-            auto h = backend->open(d, error);
-            if (!h) {
-                verdict = "cannot open: " + error;
-            } else {
-                try {
-                    const DeviceDecoder dec(parseDescriptor(h->descriptor()), quirksFor(d.vendor, d.product));
-                    verdict = kindName(dec.kind());
-                    playable += dec.kind() != DeviceKind::Other ? 1 : 0;
-                } catch (const std::exception& e) {
-                    verdict = std::string("descriptor: ") + e.what();
-                }
-            }
-            std::printf("%04x:%04x  %-14s %-40s %s\n", d.vendor, d.product, d.path.c_str(), d.name.c_str(), verdict.c_str());
+        if (udevRulesOnly) {
+            std::fputs(udevRules().c_str(), stdout);
+            return 0;
         }
+        if (supportedOnly) {
+            for (const auto& d : supportedDevices())
+                std::printf("%04x:%04x  %-9s %-11s %s\n", d.vendor, d.product, d.bus == Bus::Bluetooth ? "Bluetooth" : "USB", kindName(d.kind), d.name);
+            return 0;
+        }
+        // One scan through the same code the plugin runs, then the verdict per device.
+        {
+            HidInput scan(makeHidapiBackend(), makeLibusbWatcher());
+            scan.hotplugRescanSeconds = 60.0;
+            scan.start();
+            std::this_thread::sleep_for(std::chrono::milliseconds(300));
+            const auto devices = scan.devices();
+            if (devices.empty()) std::printf("no HID devices (hidraw) found\n");
+            for (const auto& d : devices)
+                std::printf("%04x:%04x  %-9s %-40s %s%s%s\n", d.vendor, d.product, d.bus == Bus::Bluetooth ? "Bluetooth" : "USB", d.name.c_str(),
+                            stateName(d.state), d.kind.empty() ? "" : (" (" + d.kind + ")").c_str(),
+                            d.detail.empty() ? "" : ("\n           " + d.detail).c_str());
+            std::printf("hot-plug: %s\n", scan.hotplug() ? "libusb tells arrivals and departures" : "not available, polling");
+        }
+        auto backend = makeHidapiBackend();
         if (hidSeconds > 0.0) {
-            HidInput input(std::move(backend));
+            HidInput input(std::move(backend), makeLibusbWatcher());
             input.start();
             const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(hidSeconds);
             Event e, last;

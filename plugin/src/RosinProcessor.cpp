@@ -131,7 +131,9 @@ RosinProcessor::RosinProcessor()
             stateProblem_ = juce::String("ROSIN_HID_REPLAY: ") + e.what();
         }
     }
-    hid_ = std::make_unique<hid::HidInput>(backend ? std::move(backend) : hid::makeHidapiBackend());
+    const bool replaying = backend != nullptr;
+    hid_ = std::make_unique<hid::HidInput>(replaying ? std::move(backend) : hid::makeHidapiBackend());
+    if (!replaying) hid_->watcherFactory = [] { return hid::makeLibusbWatcher(); }; // hot-plug while the input runs
     pushed_.fill(std::numeric_limits<float>::quiet_NaN());
     const int index = juce::roundToInt(instrumentRaw_->load());
     requestedInstrument_.store(index);
@@ -547,44 +549,17 @@ void RosinProcessor::getStateInformation(juce::MemoryBlock& destData)
 
 void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
 {
-    std::unique_ptr<juce::XmlElement> xml(getXmlFromBinary(data, sizeInBytes));
-    if (xml == nullptr || !xml->hasTagName(state_.state.getType())) { // not ours: keep the current state
+    state::LoadedState loaded = state::read(data, sizeInBytes, state_.state.getType().toString(), stateVersion);
+    if (loaded.tree == nullptr) { // not ours, or from a newer build: keep the current state
+        DBG("Rosin: " << loaded.problem);
         const std::lock_guard<std::mutex> lock(loadMutex_);
-        stateProblem_ = "the state is not a Rosin state: the current settings are kept";
+        stateProblem_ = loaded.problem;
         return;
     }
-    if (const juce::String problem = state::migrate(*xml, stateVersion); problem.isNotEmpty()) {
-        DBG("Rosin: " << problem);
-        const std::lock_guard<std::mutex> lock(loadMutex_);
-        stateProblem_ = problem;
-        return;
-    }
-    std::vector<engine::MappingEntry> entries;
-    if (auto* maps = xml->getChildByName("Mappings")) {
-        for (auto* m : maps->getChildIterator()) {
-            engine::MappingEntry e;
-            e.cc = m->getIntAttribute("cc", -1);
-            e.param = engine::paramIndex(m->getStringAttribute("param").toStdString());
-            e.min = static_cast<float>(m->getDoubleAttribute("min"));
-            e.max = static_cast<float>(m->getDoubleAttribute("max"));
-            e.invert = m->getBoolAttribute("invert");
-            if (e.cc >= 0 && e.cc < engine::ControllerMap::numControllers && e.param >= 0 && std::isfinite(e.min) && std::isfinite(e.max))
-                entries.push_back(e);
-        }
-        xml->removeChildElement(maps, true);
-    }
-    juce::String problems;
-    if (auto* hidXml = xml->getChildByName("Hid")) {
-        for (auto* m : hidXml->getChildIterator()) {
-            try {
-                hid_->setMapping(hid::HidMapping::fromJson(m->getAllSubText().toStdString(), "saved state"));
-            } catch (const std::exception& e) {
-                problems += juce::String(e.what()) + "; "; // keep the default map for that device
-            }
-        }
-        xml->removeChildElement(hidXml, true);
-    }
-    xml->removeAttribute("format");
+    for (const auto& m : loaded.hidMappings) hid_->setMapping(m);
+    const auto& entries = loaded.mappings;
+    const juce::String problems = loaded.problem;
+    const auto* xml = loaded.tree.get();
     const int before = juce::roundToInt(instrumentRaw_->load());
     state_.replaceState(juce::ValueTree::fromXml(*xml));
     map_.assign(entries);

@@ -398,6 +398,17 @@ TEST(ProcessorState, AStateFromANewerBuildIsRefusedWithAReason)
     const char garbage[] = "not a state at all";
     p.setStateInformation(garbage, sizeof garbage);
     EXPECT_NE(p.lastStateProblem().indexOf("not a Rosin state"), -1) << p.lastStateProblem();
+    // Found by the fuzzer: a processing instruction inside an element left unclosed sends JUCE's
+    // XML parser into an endless loop (this test would hang until ctest's timeout). Refused unread.
+    juce::MemoryBlock hostile;
+    juce::AudioProcessor::copyXmlToBinary(juce::XmlElement("placeholder"), hostile);
+    const juce::String text = R"(<?xml version="1.0"?><RosinState format="rosin-state/2"><??><e t=""><??>a)";
+    hostile.setSize(8);
+    hostile.append(text.toRawUTF8(), text.getNumBytesAsUTF8() + 1);
+    static_cast<juce::uint32*>(hostile.getData())[1] = juce::ByteOrder::swapIfBigEndian(static_cast<juce::uint32>(text.getNumBytesAsUTF8() + 1));
+    p.setStateInformation(hostile.getData(), static_cast<int>(hostile.getSize()));
+    EXPECT_NE(p.lastStateProblem().indexOf("malformed"), -1) << p.lastStateProblem();
+    EXPECT_FLOAT_EQ(raw(p, "articulation"), 2.0f);
 }
 
 TEST(ProcessorParameters, AChoiceAddedLaterDoesNotMoveAutomation)

@@ -10,11 +10,17 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 
 #include "rosin/hid/HidInput.h"
 
 namespace rosin::hid {
 namespace {
+// hidapi keeps process-wide state (hid_init/hid_exit): the first backend initialises it and the
+// last one tears it down, so closing one plugin instance never pulls it from under another.
+std::mutex hidapiMutex;
+int hidapiCount = 0;
+
 std::string narrow(const wchar_t* w)
 {
     std::string s;
@@ -61,8 +67,16 @@ private:
 
 class HidapiBackend : public DeviceBackend {
 public:
-    HidapiBackend() { hid_init(); }
-    ~HidapiBackend() override { hid_exit(); }
+    HidapiBackend()
+    {
+        const std::lock_guard<std::mutex> lock(hidapiMutex);
+        if (hidapiCount++ == 0) hid_init();
+    }
+    ~HidapiBackend() override
+    {
+        const std::lock_guard<std::mutex> lock(hidapiMutex);
+        if (--hidapiCount == 0) hid_exit();
+    }
 
     std::vector<DeviceInfo> enumerate() override
     {
@@ -74,6 +88,8 @@ public:
             info.vendor = d->vendor_id;
             info.product = d->product_id;
             info.name = narrow(d->manufacturer_string) + " " + narrow(d->product_string);
+            info.bus = d->bus_type == HID_API_BUS_BLUETOOTH ? Bus::Bluetooth : Bus::Usb;
+            if (info.bus == Bus::Usb) usbAddressOf(info.path, info.usbBus, info.usbAddress);
             out.push_back(info);
         }
         hid_free_enumeration(list);
@@ -86,7 +102,7 @@ public:
         hid_device* d = hid_open_path(info.path.c_str());
         if (!d) {
             error = errno == EACCES || errno == EPERM
-                        ? "permission denied: install the udev rule (scripts/udev/70-rosin-hid.rules, see README)"
+                        ? "permission denied: the udev rule is missing (rosin-host hid --udev-rules, see README)"
                         : (errno ? std::strerror(errno) : "hidapi could not open it");
             return nullptr;
         }
@@ -96,5 +112,11 @@ public:
 } // namespace
 
 std::unique_ptr<DeviceBackend> makeHidapiBackend() { return std::make_unique<HidapiBackend>(); }
+
+int hidapiUsers()
+{
+    const std::lock_guard<std::mutex> lock(hidapiMutex);
+    return hidapiCount;
+}
 
 } // namespace rosin::hid

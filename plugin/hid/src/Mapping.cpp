@@ -38,17 +38,8 @@ DeviceKind classify(const Descriptor& d)
     return DeviceKind::Other;
 }
 
-Quirks quirksFor(std::uint16_t vendor, std::uint16_t product)
-{
-    Quirks q;
-    if (vendor == 0x046D && (product == 0xC626 || product == 0xC627 || product == 0xC628)) q.forceAbsolute = true; // 3Dconnexion on Logitech IDs
-    if (vendor == 0x256F) q.forceAbsolute = true;                            // 3Dconnexion's own VID
-    if (vendor == 0x11C0 && product == 0x5606) q.hatDegreesPerStep = 360.0 / 240.0; // Raptor MACH 2: 0..239 over 360 degrees
-    return q;
-}
-
-DeviceDecoder::DeviceDecoder(Descriptor descriptor, Quirks quirks)
-    : descriptor_(std::move(descriptor)), quirks_(quirks), kind_(classify(descriptor_))
+DeviceDecoder::DeviceDecoder(Descriptor descriptor, Quirks quirks, DeviceKind kind)
+    : descriptor_(std::move(descriptor)), quirks_(quirks), kind_(kind != DeviceKind::Other ? kind : classify(descriptor_))
 {
 }
 

@@ -9,7 +9,7 @@ Document Document::parse(const std::string& text, std::string origin)
     Json root;
     try {
         root = Json::parse(text);
-    } catch (const Json::parse_error& e) {
+    } catch (const Json::exception& e) { // parse errors, and numbers too large for a double (fuzzer)
         throw PresetError(origin + ": not valid JSON (" + e.what() + ")");
     }
     if (!root.is_object()) throw PresetError(origin + ": the top level must be an object");

@@ -40,7 +40,9 @@ struct DeviceState {
 class DeviceDecoder {
 public:
     DeviceDecoder() = default;
-    DeviceDecoder(Descriptor descriptor, Quirks quirks);
+    /// `kind` other than Other overrides what the descriptor suggests (the device table, or the
+    /// USB product string, knows better where a descriptor is ambiguous).
+    DeviceDecoder(Descriptor descriptor, Quirks quirks, DeviceKind kind = DeviceKind::Other);
     /// One report as hidraw delivers it. False (state untouched) when the report is unknown or short.
     bool apply(const std::uint8_t* report, std::size_t size, DeviceState& state) const;
     const Descriptor& descriptor() const { return descriptor_; }

@@ -1,17 +1,33 @@
 // libFuzzer target: the descriptor parser, then the report decoder and the bow mapper on
-// whatever reports follow. Input: 2 bytes of descriptor length (little-endian), the
+// whatever reports follow, with every quirk set the device table holds. Input: 1 byte choosing
+// the device (its quirks and its kind), 2 bytes of descriptor length (little-endian), the
 // descriptor, then reports of 1 length byte + data. Build and run: scripts/fuzz.sh.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "rosin/hid/Descriptor.h"
+#include "rosin/hid/Devices.h"
 #include "rosin/hid/Mapping.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {
     using namespace rosin::hid;
-    if (size < 2) return 0;
+    if (size < 3) return 0;
+    // 0: no device known (the descriptor decides); 1..N: the table's devices, each with its
+    // quirks and kind; N+1: 3Dconnexion's vendor-wide quirk.
+    const auto devices = supportedDevices();
+    const std::size_t choice = data[0] % (devices.size() + 2);
+    Quirks quirks{};
+    DeviceKind kind = DeviceKind::Other;
+    if (choice >= 1 && choice <= devices.size()) {
+        quirks = devices[choice - 1].quirks;
+        kind = devices[choice - 1].kind;
+    } else if (choice == devices.size() + 1) {
+        quirks = quirksFor(0x256F, 0xFFFF);
+    }
+    ++data;
+    --size;
     const std::size_t len = std::min<std::size_t>(data[0] | (data[1] << 8), size - 2);
     Descriptor d;
     try {
@@ -24,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (void)physicalValue(f, f.logicalMax);
         (void)normalisedValue(f, f.logicalMin);
     }
-    DeviceDecoder decoder(d, quirksFor(0x046D, 0xC626));
+    DeviceDecoder decoder(d, quirks, kind);
     BowMapper mapper(HidMapping::defaultFor(decoder.kind()));
     DeviceState state;
     std::size_t at = 2 + len;
