@@ -1,4 +1,5 @@
 #include "rosin/engine/StringChooser.h"
+#include "rosin/engine/Synth.h"
 
 #include <algorithm>
 #include <cmath>
@@ -63,6 +64,31 @@ int StringChooser::harmonic(double frequency, int& string) const noexcept
     }
     string = 0;
     return 2;
+}
+
+// The instrument's strings as the model takes them (units, rosin, the parameters' friction
+// choices), and the force scale that puts every string at the same Schelleng point.
+dsp::BowedStringConfig stringConfig(const InstrumentPreset& instrument, int s, const ParamValues& params)
+{
+    const auto p = [&](Param q) { return sanitise(q, params[static_cast<std::size_t>(q)]); };
+    dsp::BowedStringConfig c;
+    c.string = instrument.strings[static_cast<std::size_t>(std::clamp(s, 0, std::max(0, instrument.stringCount - 1)))];
+    c.waveguide.lowestPitchRatio = 0.5; // an octave of bend below the open string
+    c.waveguide.dispersion = false;     // the allpass fit is not redone per stop
+    c.friction.switchable = true;
+    c.friction.model = static_cast<dsp::FrictionModel>(static_cast<int>(p(Param::FrictionModel)));
+    c.friction.contactLaw = p(Param::ContactLaw) > 0.5f ? dsp::ContactLaw::PowerLaw : dsp::ContactLaw::Amontons;
+    c.friction.thermal.glassTransitionCelsius = p(Param::RosinTg);
+    c.friction.thermal.ambientCelsius = p(Param::Ambient);
+    c.friction.thermal.footprintRatio = p(Param::Footprint);
+    return c;
+}
+
+double stringForceScale(const InstrumentPreset& instrument, int s)
+{
+    if (s < 0 || s >= instrument.stringCount) return 1.0;
+    const double zRef = instrument.strings[static_cast<std::size_t>(std::min(2, instrument.stringCount - 1))].impedance();
+    return instrument.strings[static_cast<std::size_t>(s)].impedance() / zRef;
 }
 
 } // namespace rosin::engine
