@@ -474,8 +474,13 @@ TEST(ProcessorThreads, StatesMapsLearnAndEnginesChangeWhileAudioRuns)
         }
     });
     p.parameters().getParameter("hid_input")->setValueNotifyingHost(1.0f);
-    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(3);
-    for (int k = 0; std::chrono::steady_clock::now() < end; ++k) {
+    // At least 3 s and 150 blocks (a loaded machine under ThreadSanitizer is slow), at most 30 s.
+    const auto start = std::chrono::steady_clock::now();
+    auto running = [&] {
+        const auto t = std::chrono::steady_clock::now() - start;
+        return t < std::chrono::seconds(3) || (blocksDone.load() < 150 && t < std::chrono::seconds(30));
+    };
+    for (int k = 0; running(); ++k) {
         const auto& s = states[static_cast<std::size_t>(k % 4)];
         p.setStateInformation(s.getData(), static_cast<int>(s.getSize()));
         p.loadMapping(k % 2 ? "keyboard" : "mpe");

@@ -244,18 +244,25 @@ void HidInput::run()
             info = candidate;
             info.name = st.name;
         }
-        {
-            const std::lock_guard<std::mutex> lock(mutex_);
-            devices_ = seen;
-        }
-        if (!handle) {
+        // The line and the list change together: whoever reads one sees the other of the same scan.
+        std::string summary;
+        if (handle) {
+            summary = info.name + " (" + kindName(decoder.kind()) + ")";
+        } else {
             const auto blocked = std::find_if(seen.begin(), seen.end(), [](const DeviceStatus& s) {
                 return s.state == DeviceStatus::State::NoPermission || s.state == DeviceStatus::State::Failed;
             });
             if (blocked != seen.end())
-                setStatus(blocked->name + ": " + (blocked->state == DeviceStatus::State::NoPermission ? "no permission (add the udev rule)" : blocked->detail));
+                summary = blocked->name + ": " + (blocked->state == DeviceStatus::State::NoPermission ? "no permission (add the udev rule)" : blocked->detail);
             else
-                setStatus(gone.empty() ? "no controller" : gone + " unplugged, waiting for a controller");
+                summary = gone.empty() ? "no controller" : gone + " unplugged, waiting for a controller";
+        }
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            devices_ = seen;
+            status_ = summary;
+        }
+        if (!handle) {
             waitForDevices(hotplug() ? hotplugRescanSeconds : rescanSeconds);
             continue;
         }
@@ -273,11 +280,10 @@ void HidInput::run()
             mapper.release(now(), events); // lift the bow and end its notes
             send();
             gone = info.name;
-            setStatus(info.name + " " + why);
             const std::lock_guard<std::mutex> lock(mutex_);
+            status_ = info.name + " " + why;
             devices_.clear();
         };
-        setStatus(info.name + " (" + kindName(decoder.kind()) + ")");
         while (!stopRequested_) {
             if (const unsigned g = mappingGeneration_.load(std::memory_order_acquire); g != generation) {
                 generation = g; // edited in the window: applies from the next report

@@ -18,6 +18,8 @@ namespace rosin::hid {
 namespace {
 // hidapi keeps process-wide state (hid_init/hid_exit): the first backend initialises it and the
 // last one tears it down, so closing one plugin instance never pulls it from under another.
+// hid_enumerate and hid_open_path touch that state too (hidapi 0.13 calls hid_init inside them),
+// so two instances' threads take turns (ThreadSanitizer saw the race). Reads stay concurrent.
 std::mutex hidapiMutex;
 int hidapiCount = 0;
 
@@ -32,7 +34,11 @@ std::string narrow(const wchar_t* w)
 class HidapiHandle : public DeviceHandle {
 public:
     HidapiHandle(hid_device* d, std::string path) : device_(d), path_(std::move(path)) {}
-    ~HidapiHandle() override { hid_close(device_); }
+    ~HidapiHandle() override
+    {
+        const std::lock_guard<std::mutex> lock(hidapiMutex);
+        hid_close(device_);
+    }
 
     int read(std::uint8_t* buffer, std::size_t size, int timeoutMs) override
     {
@@ -81,6 +87,7 @@ public:
     std::vector<DeviceInfo> enumerate() override
     {
         std::vector<DeviceInfo> out;
+        const std::lock_guard<std::mutex> lock(hidapiMutex);
         hid_device_info* list = hid_enumerate(0, 0);
         for (auto* d = list; d; d = d->next) {
             DeviceInfo info;
@@ -98,6 +105,7 @@ public:
 
     std::unique_ptr<DeviceHandle> open(const DeviceInfo& info, std::string& error) override
     {
+        const std::lock_guard<std::mutex> lock(hidapiMutex);
         errno = 0;
         hid_device* d = hid_open_path(info.path.c_str());
         if (!d) {
