@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Install, build and run every test except the `long` soak runs (run those with: ctest --test-dir build -L long),
-# then the engine and processor tests again under ThreadSanitizer (scripts/tsan.sh, label tsan).
+# then the engine, processor and HID tests again under ThreadSanitizer (scripts/tsan.sh, label tsan).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bash scripts/install-deps.sh
