@@ -184,7 +184,24 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
 {
     const std::vector<StudySet> plan = planStudy(o);
     const Distributed& mpi = Distributed::instance();
+    json planJson = json::array();
+    for (const auto& p : plan) planJson.push_back({{"index", p.index}, {"seed", p.seed}, {"effects", p.effects}});
+    planJson = json{{"grid", o.grid}, {"seed", o.seed}, {"sets", planJson}};
+    // A folder resumes only the study it holds: sets are skipped by folder name, so a different
+    // seed, size or grid would silently mix two studies.
+    if (fs::exists(dir / "plan.json")) {
+        json before;
+        try {
+            std::ifstream(dir / "plan.json") >> before;
+        } catch (const json::exception& e) {
+            throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
+        }
+        if (before != planJson)
+            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls or grid); use a new folder");
+    }
     fs::create_directories(dir / "sets");
+    if (mpi.isRoot() && !fs::exists(dir / "plan.json")) std::ofstream(dir / "plan.json") << planJson.dump(1) << "\n";
+    mpi.barrier();
     std::size_t done = 0;
     for (const StudySet& p : plan) {
         ++done;
@@ -219,11 +236,6 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         if (!o.keepSets) fs::remove_all(here / "set");
     }
     mpi.barrier();
-    if (mpi.isRoot()) {
-        json plan_ = json::array();
-        for (const auto& p : plan) plan_.push_back({{"index", p.index}, {"seed", p.seed}, {"effects", p.effects}});
-        std::ofstream(dir / "plan.json") << json{{"grid", o.grid}, {"seed", o.seed}, {"sets", plan_}}.dump(1) << "\n";
-    }
 }
 
 std::string scoreStudy(const fs::path& dir)

@@ -1,0 +1,161 @@
+// The study harness (`rosin study`) scores the diagnosis: its plan, its refusal to mix two studies
+// in one folder, and its counting, checked on hand-written truths and findings whose scores are
+// known. (The study's own run is minutes per set: it is run by hand, see docs/diagnosis-study.md.)
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "rosin/lab/Error.h"
+#include "rosin/lab/Study.h"
+
+using namespace rosin::lab;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+fs::path freshDir(const std::string& name)
+{
+    const fs::path dir = fs::temp_directory_path() / ("rosin-study-test-" + name + "-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+void writeSet(const fs::path& dir, int index, const json& truth, const json& diagnosis)
+{
+    char name[16];
+    std::snprintf(name, sizeof name, "%03d", index);
+    fs::create_directories(dir / "sets" / name / "diagnosis");
+    std::ofstream(dir / "sets" / name / "truth.json") << truth.dump();
+    std::ofstream(dir / "sets" / name / "diagnosis" / "diagnosis.json") << diagnosis.dump();
+}
+
+json finding(const std::string& effect, const std::string& parameter, double value, double low, double high)
+{
+    return {{"effect", effect}, {"parameters", {{parameter, {{"value", value}, {"ci95", {low, high}}}}}}};
+}
+
+json diagnosis(const json& findings) { return {{"findings", findings}, {"gain", {{"baseline", 0.3}, {"final", 0.08}}}}; }
+} // namespace
+
+TEST(Study, PlanHasTheAskedNullsAndMixOfSinglesDoublesAndTriples)
+{
+    StudyOptions o;
+    o.sets = 40;
+    o.nulls = 10;
+    o.seed = 77;
+    const std::vector<StudySet> plan = planStudy(o);
+    ASSERT_EQ(plan.size(), 40u);
+    int bySize[4] = {0, 0, 0, 0};
+    std::set<std::uint64_t> seeds;
+    for (const StudySet& s : plan) {
+        ASSERT_LE(s.effects.size(), 3u);
+        ++bySize[s.effects.size()];
+        seeds.insert(s.seed);
+        std::set<std::string> distinct(s.effects.begin(), s.effects.end());
+        EXPECT_EQ(distinct.size(), s.effects.size()) << "set " << s.index << " names an effect twice";
+    }
+    // 30 sets with effects: 45 % singles (13.5 -> 14), 35 % doubles (10.5 -> 11), the rest triples.
+    EXPECT_EQ(bySize[0], 10);
+    EXPECT_EQ(bySize[1], 14);
+    EXPECT_EQ(bySize[2], 11);
+    EXPECT_EQ(bySize[3], 5);
+    EXPECT_EQ(seeds.size(), plan.size()) << "every set draws its own rig";
+    // The plan follows from the seed alone, and another seed gives another order.
+    const std::vector<StudySet> again = planStudy(o);
+    for (std::size_t k = 0; k < plan.size(); ++k) EXPECT_EQ(again[k].effects, plan[k].effects);
+    o.seed = 78;
+    const std::vector<StudySet> other = planStudy(o);
+    int differ = 0;
+    for (std::size_t k = 0; k < plan.size(); ++k) differ += other[k].effects != plan[k].effects;
+    EXPECT_GT(differ, 10);
+}
+
+TEST(Study, PlanRefusesMoreNullsThanSets)
+{
+    StudyOptions o;
+    o.sets = 5;
+    o.nulls = 6;
+    EXPECT_THROW(planStudy(o), LabError);
+}
+
+TEST(Study, AFolderResumesOnlyTheStudyItHolds)
+{
+    const fs::path dir = freshDir("resume");
+    StudyOptions o;
+    o.sets = 4;
+    o.nulls = 1;
+    o.seed = 5;
+    json plan = json::array();
+    for (const StudySet& s : planStudy(o)) plan.push_back({{"index", s.index}, {"seed", s.seed}, {"effects", s.effects}});
+    std::ofstream(dir / "plan.json") << json{{"grid", o.grid}, {"seed", o.seed}, {"sets", plan}}.dump(1);
+    StudyOptions other = o;
+    other.seed = 6; // another study: its sets must not be skipped as "already done"
+    try {
+        runStudy(dir, other);
+        FAIL() << "a folder holding another study was resumed";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("plan.json"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir / "sets")) << "nothing is started in a refused folder";
+    fs::remove_all(dir);
+}
+
+TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
+{
+    const fs::path dir = freshDir("score");
+    // 0: a null set, nothing named. 1: a null set naming a spurious shift.
+    writeSet(dir, 0, {{"effects", json::array()}, {"params", json::object()}}, diagnosis(json::array({{{"effect", "none"}}})));
+    writeSet(dir, 1, {{"effects", json::array()}, {"params", json::object()}},
+             diagnosis(json::array({finding("rosin_temperature_shift", "shift_k", -2.0, -3.5, -0.5)})));
+    // 2: Hertzian contact named, 0.70 for a true 0.67 (within 0.05), interval holds the truth.
+    writeSet(dir, 2, {{"effects", {"hertzian_contact"}}, {"params", {{"load_exponent", 0.67}}}},
+             diagnosis(json::array({finding("hertzian_contact", "load_exponent", 0.70, 0.65, 0.75)})));
+    // 3: Hertzian contact named, 0.80 for a true 0.67 (outside), interval misses the truth;
+    //    torsion hidden beside it and missed.
+    writeSet(dir, 3, {{"effects", {"hertzian_contact", "torsional_compliance"}}, {"params", {{"load_exponent", 0.67}, {"zt_ratio", 3.0}}}},
+             diagnosis(json::array({finding("hertzian_contact", "load_exponent", 0.80, 0.76, 0.84)})));
+    // 4: torsion named, Z_t/Z_0 3.3 for 3.0 (10 %, within 20 %), interval holds it.
+    writeSet(dir, 4, {{"effects", {"torsional_compliance"}}, {"params", {{"zt_ratio", 3.0}}}},
+             diagnosis(json::array({finding("torsional_compliance", "zt_ratio", 3.3, 2.5, 4.0)})));
+
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    const json& s = study["summary"];
+    EXPECT_EQ(s["sets"], 5);
+    EXPECT_EQ(s["exact"], 3); // sets 0, 2 and 4
+    EXPECT_EQ(s["null_sets"], 2);
+    EXPECT_EQ(s["null_false_positives"], 1);
+    EXPECT_EQ(s["detection"]["hertzian_contact"]["hidden"], 2);
+    EXPECT_EQ(s["detection"]["hertzian_contact"]["named"], 2);
+    EXPECT_EQ(s["detection"]["torsional_compliance"]["hidden"], 2);
+    EXPECT_EQ(s["detection"]["torsional_compliance"]["named"], 1);
+    EXPECT_EQ(s["detection"]["rosin_temperature_shift"]["false_positive"], 1);
+    EXPECT_EQ(s["detection"]["rosin_temperature_shift"]["not_hidden"], 5);
+    EXPECT_EQ(s["parameters"]["load_exponent"]["named"], 2);
+    EXPECT_EQ(s["parameters"]["load_exponent"]["within_tolerance"], 1);
+    EXPECT_NEAR(s["parameters"]["load_exponent"]["worst_error"].get<double>(), 0.13, 1e-9);
+    EXPECT_EQ(s["parameters"]["zt_ratio"]["within_tolerance"], 1);
+    // A shift named on a null set has no truth to score against: only hidden effects' parameters count.
+    EXPECT_FALSE(s["parameters"].contains("shift_k"));
+    // Intervals: 2 of the 3 scored parameters hold their truth.
+    EXPECT_NEAR(s["coverage"].get<double>(), 2.0 / 3.0, 1e-12);
+    EXPECT_NE(md.find("Null sets naming any effect: 1 of 2"), std::string::npos) << md;
+    EXPECT_TRUE(fs::exists(dir / "study.csv"));
+    EXPECT_TRUE(fs::exists(dir / "study.png"));
+    fs::remove_all(dir);
+}
+
+TEST(Study, ScoringAnEmptyFolderSaysSo)
+{
+    const fs::path dir = freshDir("empty");
+    EXPECT_THROW(scoreStudy(dir), LabError);
+    fs::create_directories(dir / "sets");
+    EXPECT_THROW(scoreStudy(dir), LabError);
+    fs::remove_all(dir);
+}
