@@ -452,7 +452,7 @@ TEST(EngineDirectBow, AControllersHandHoldsTheBowThroughTheSameMapping)
     // Released: the channel's virtual player bows again (the direction alternates, speed positive first).
     s->apply(control(Control::DirectRelease, 0.0f));
     render(*s, fs / 4, {off(0, 50), on(10, 57)});
-    EXPECT_FALSE(s->performance().channel(0).direct);
+    EXPECT_FALSE(s->performance().channel(0).hand.holds);
 }
 
 TEST(EngineDirectBow, MidiPressureAndAControllerReachTheSameForce)

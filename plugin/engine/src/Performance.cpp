@@ -44,14 +44,7 @@ Performance::Channel Performance::effective(int c) const noexcept
     e.volume *= m.volume;
     e.bend += m.bend;
     e.sustain = e.sustain || m.sustain;
-    if (!e.direct && m.direct) {
-        e.direct = true;
-        e.engaged = m.engaged;
-        e.directSpeed = m.directSpeed;
-        e.directForce = m.directForce;
-        e.directPosition = m.directPosition;
-        e.preferredString = m.preferredString;
-    }
+    if (!e.hand.holds && m.hand.holds) e.hand = m.hand;
     return e;
 }
 
@@ -115,34 +108,24 @@ void Performance::apply(const ControlEvent& e) noexcept
         break;
     }
     case Control::DirectSpeed:
-        ch.direct = true;
-        ch.directSpeed = std::clamp(v, -1.0f, 1.0f);
+        ch.hand.holds = true;
+        ch.hand.speed = std::clamp(v, -1.0f, 1.0f);
         break;
     case Control::Engage:
-        ch.direct = true;
-        ch.engaged = v >= 0.5f;
+        ch.hand.holds = true;
+        ch.hand.engaged = v >= 0.5f;
         break;
-    case Control::DirectRelease:
-        ch.direct = ch.engaged = false;
-        ch.directSpeed = 0.0f;
-        ch.directForce = ch.directPosition = -1.0f;
-        ch.preferredString = -1;
-        break;
-    case Control::DirectForce: ch.directForce = std::clamp(v, 0.0f, 1.0f); break;
-    case Control::DirectPosition: ch.directPosition = std::clamp(v, 0.0f, 1.0f); break;
-    case Control::StringChoice: ch.preferredString = v >= 0.0f ? static_cast<int>(v) : -1; break;
+    case Control::DirectRelease: ch.hand = {}; break;
+    case Control::DirectForce: ch.hand.force = std::clamp(v, 0.0f, 1.0f); break;
+    case Control::DirectPosition: ch.hand.position = std::clamp(v, 0.0f, 1.0f); break;
+    case Control::StringChoice: ch.hand.preferredString = v >= 0.0f ? static_cast<int>(v) : -1; break;
     case Control::SoundOff:
     case Control::NotesOff: removeHeld(c, -1); break;
     case Control::ResetControls: {
         // RP-015: controllers back to their defaults; the bend range and the pedal's notes go too.
-        const Channel kept = ch;
+        const Channel::Hand kept = ch.hand;
         ch = Channel{};
-        ch.direct = kept.direct;
-        ch.engaged = kept.engaged;
-        ch.directSpeed = kept.directSpeed;
-        ch.directForce = kept.directForce;
-        ch.directPosition = kept.directPosition;
-        ch.preferredString = kept.preferredString;
+        ch.hand = kept;
         releaseSustained(c);
         break;
     }

@@ -68,7 +68,7 @@ void Synth::noteOn(int ch, int note, float velocity) noexcept
     for (auto& v : voices_)
         if (v.active() && !v.released() && v.channel() == ch) occupied |= 1u << v.string();
     const int s = chooser_.choose(f, static_cast<StringPolicy>(static_cast<int>(params_[index(Param::StringPolicy)])),
-                                  static_cast<int>(params_[index(Param::FixedString)]), performance_->effective(ch).preferredString,
+                                  static_cast<int>(params_[index(Param::FixedString)]), performance_->effective(ch).hand.preferredString,
                                   lastString_[static_cast<std::size_t>(ch)], occupied);
     Voice* v = findVoiceToStart();
     if (!v) return;

@@ -129,14 +129,14 @@ void Voice::updateControl(const VoiceContext& ctx) noexcept
 {
     const ParamValues& params = *ctx.params;
     const Performance::Channel c = ctx.performance->effective(channel_);
-    direct_ = c.direct;
-    engaged_ = c.engaged;
+    direct_ = c.hand.holds;
+    engaged_ = c.hand.engaged;
     // The one mapping from normalised controls to the model's units (Controls.h).
-    const float force01 = polyPressure_ >= 0.0f ? polyPressure_ : c.direct && c.directForce >= 0.0f ? c.directForce : c.force;
-    const float speed = c.direct ? c.directSpeed : (c.speed >= 0.0f ? c.speed : 0.5f);
-    const float position01 = c.direct && c.directPosition >= 0.0f ? c.directPosition : c.position;
+    const float force01 = polyPressure_ >= 0.0f ? polyPressure_ : c.hand.holds && c.hand.force >= 0.0f ? c.hand.force : c.force;
+    const float speed = c.hand.holds ? c.hand.speed : (c.speed >= 0.0f ? c.speed : 0.5f);
+    const float position01 = c.hand.holds && c.hand.position >= 0.0f ? c.hand.position : c.position;
     const BowTarget t = mapBow(params, (*ctx.stringScale)[static_cast<std::size_t>(string_)], force01, speed, position01);
-    targetForce_ = c.direct && !c.engaged ? 0.0 : t.force;
+    targetForce_ = c.hand.holds && !c.hand.engaged ? 0.0 : t.force;
     targetSpeed_ = t.speed;
     // The bow point glides to its target; once there it stops moving (the waveguide redesigns its
     // taps whenever beta changes, so an endless creep of 1e-9 would cost that every control tick).

@@ -20,12 +20,15 @@ public:
         float force = -1.0f, speed = -1.0f, position = -1.0f; ///< normalised; < 0 = not sent yet
         float vibrato = 0.0f, volume = 1.0f, bend = 0.0f;      ///< 0..1, 0..1, semitones
         bool sustain = false;
-        bool direct = false, engaged = false; ///< a controller holds the bow; it touches the string
-        float directSpeed = 0.0f;             ///< -1..1, signed
-        /// The holding controller's force and position, kept apart from the channel's (CC2, CC74)
-        /// so that a keyboard played after the tablet is put down gets its own values back.
-        float directForce = -1.0f, directPosition = -1.0f;
-        int preferredString = -1;             ///< string chosen by a controller, -1 none
+        /// A controller's hand on the bow (HID): kept, passed to zone members and forgotten as one.
+        /// Its force and position stay apart from the channel's (CC2, CC74) so that a keyboard
+        /// played after the tablet is put down gets its own values back.
+        struct Hand {
+            bool holds = false, engaged = false;    ///< a controller holds the bow; it touches the string
+            float speed = 0.0f;                     ///< -1..1, signed
+            float force = -1.0f, position = -1.0f;  ///< 0..1; < 0 = not sent, the channel's apply
+            int preferredString = -1;               ///< string chosen by a controller, -1 none
+        } hand;
     };
     struct Held {
         std::int8_t channel = 0, note = 0;
