@@ -460,6 +460,37 @@ TEST(HidUdev, EveryProfileHasItsLineAndNoOtherDeviceMatches)
     EXPECT_TRUE(udevLineMatches(R"(SUBSYSTEM=="hidraw", KERNELS=="0005:045E:02FD.*", TAG+="uaccess")", 0x045E, 0x02FD, Bus::Bluetooth, "hidraw"));
 }
 
+// The window asks whether hot-plug is on while the loader thread starts and stops the input, and
+// with it makes and drops the watcher (a race on the watcher under ThreadSanitizer before the
+// answer was published on its own).
+TEST(HidHotplug, AskingForHotplugWhileTheInputStartsAndStops)
+{
+    auto bus = std::make_shared<FakeBus>();
+    HidInput in(std::make_unique<FakeBackend>(bus));
+    in.watcherFactory = [bus] { return std::make_unique<FakeWatcher>(bus); };
+    EXPECT_FALSE(in.hotplug()) << "no watcher until the input starts";
+    std::atomic<bool> done{false};
+    std::atomic<int> on{0}, asked{0};
+    std::thread window([&] {
+        while (!done) {
+            on += in.hotplug() ? 1 : 0;
+            ++asked;
+            (void)in.status();
+        }
+    });
+    for (int i = 0; i < 20; ++i) {
+        in.start();
+        EXPECT_TRUE(in.hotplug());
+        std::this_thread::sleep_for(2ms);
+        in.stop();
+        EXPECT_FALSE(in.hotplug()) << "the made watcher is dropped on stop";
+    }
+    done = true;
+    window.join();
+    EXPECT_GT(asked.load(), 20);
+    EXPECT_GT(on.load(), 0);
+}
+
 // The real libusb watcher on this machine: it starts, says whether hot-plug is there, lists the
 // attached devices (none may be attached: then the list is empty) and stops without hanging.
 TEST(HidHotplug, TheLibusbWatcherStartsAndStops)

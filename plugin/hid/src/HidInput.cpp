@@ -52,6 +52,7 @@ const char* stateName(DeviceStatus::State s)
 HidInput::HidInput(std::unique_ptr<DeviceBackend> backend, std::unique_ptr<UsbWatcher> watcher)
     : backend_(std::move(backend)), watcher_(std::move(watcher))
 {
+    hotplug_ = watching();
     for (DeviceKind k : {DeviceKind::Tablet, DeviceKind::Gamepad, DeviceKind::SpaceMouse, DeviceKind::Joystick})
         mappings_.push_back(HidMapping::defaultFor(k));
 }
@@ -87,6 +88,7 @@ bool HidInput::setBackend(std::unique_ptr<DeviceBackend> backend, std::unique_pt
     backend_ = std::move(backend);
     watcher_ = std::move(watcher);
     watcherFactory = nullptr; // the watcher belongs to the device layer it came with
+    hotplug_ = watching();
     return true;
 }
 
@@ -98,6 +100,7 @@ void HidInput::start()
         watcher_ = watcherFactory();
         madeWatcher_ = true;
     }
+    hotplug_ = watching();
     thread_ = std::thread([this] { run(); });
 }
 
@@ -109,6 +112,7 @@ void HidInput::stop()
         watcher_.reset();
         madeWatcher_ = false;
     }
+    hotplug_ = watching();
     running_ = false;
     setStatus("stopped");
 }
@@ -125,7 +129,7 @@ std::vector<DeviceStatus> HidInput::devices() const
     return devices_;
 }
 
-bool HidInput::hotplug() const { return watcher_ && watcher_->hotplug(); }
+bool HidInput::watching() const { return watcher_ && watcher_->hotplug(); }
 
 void HidInput::setStatus(const std::string& s)
 {
@@ -149,7 +153,7 @@ bool HidInput::waitForDevices(double seconds)
 {
     const double until = now() + seconds;
     while (!stopRequested_ && now() < until) {
-        if (!hotplug()) { // polling: the next scan enumerates again
+        if (!watching()) { // polling: the next scan enumerates again
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
             continue;
         }
@@ -162,7 +166,7 @@ bool HidInput::waitForDevices(double seconds)
 
 bool HidInput::departed(const DeviceInfo& info)
 {
-    if (!hotplug()) return false; // without hot-plug, a failed read tells
+    if (!watching()) return false; // without hot-plug, a failed read tells
     bool left = false;
     for (const UsbChange& c : watcher_->wait(0))
         if (!c.arrived && sameUsb(info, c.device)) left = true;
@@ -176,8 +180,10 @@ void HidInput::run()
     std::string gone;
     while (!stopRequested_) {
         // One scan: every device gets a fresh status; nothing from an earlier scan survives.
-        const std::vector<UsbDevice> usb = watcher_ ? watcher_->attached() : std::vector<UsbDevice>{};
+        // hidraw first, then USB: a device that arrives between the two waits for the next scan
+        // instead of being listed without its USB name strings.
         std::vector<DeviceInfo> found = backend_->enumerate();
+        const std::vector<UsbDevice> usb = watcher_ ? watcher_->attached() : std::vector<UsbDevice>{};
         // The devices Rosin knows first; hidapi lists a device once per top-level collection.
         std::stable_partition(found.begin(), found.end(), [](const DeviceInfo& d) { return findSupported(d.vendor, d.product, d.bus) != nullptr; });
         std::set<std::string> paths;
@@ -263,7 +269,7 @@ void HidInput::run()
             status_ = summary;
         }
         if (!handle) {
-            waitForDevices(hotplug() ? hotplugRescanSeconds : rescanSeconds);
+            waitForDevices(watching() ? hotplugRescanSeconds : rescanSeconds);
             continue;
         }
         ++connections_;

@@ -96,8 +96,9 @@ public:
     /// Every device of the last scan and what became of it. An error belongs to its scan: a
     /// device that went away, or opened later, leaves no message behind.
     std::vector<DeviceStatus> devices() const;
-    /// True when arrivals wake the thread (libusb hot-plug); false when it polls.
-    bool hotplug() const;
+    /// True when arrivals wake the thread (libusb hot-plug); false when it polls. Any thread: the
+    /// watcher itself is made and dropped by start() and stop(), which may run elsewhere.
+    bool hotplug() const { return hotplug_.load(); }
     std::uint64_t reportsRead() const { return reports_.load(); }
     int connections() const { return connections_.load(); }
 
@@ -111,12 +112,14 @@ private:
     void run();
     bool waitForDevices(double seconds); ///< true when something arrived
     bool departed(const DeviceInfo& info); ///< the watcher says this device has left
+    bool watching() const;                 ///< the watcher tells arrivals (the owner of watcher_ asks)
     void setStatus(const std::string& s);
     bool push(const Event& e);
 
     std::unique_ptr<DeviceBackend> backend_;
     std::unique_ptr<UsbWatcher> watcher_;
     bool madeWatcher_ = false;
+    std::atomic<bool> hotplug_{false}; ///< watching(), published for other threads
     Queue queue_;
     std::thread thread_;
     std::atomic<bool> running_{false}, stopRequested_{false};
