@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "StateFormat.h"
+#include "rosin/engine/ControllerMap.h"
 #include "rosin/engine/Parameters.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
@@ -31,7 +32,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!s.tree->hasTagName("RosinState") || s.tree->getChildByName("Mappings") != nullptr || s.tree->getChildByName("Hid") != nullptr)
         __builtin_trap();
     for (const auto& e : s.mappings)
-        if (e.cc < 0 || e.cc >= 120 || e.param < 0 || e.param >= rosin::engine::paramCount || !std::isfinite(e.min) || !std::isfinite(e.max))
+        if (e.cc < 0 || e.cc >= rosin::engine::ControllerMap::numControllers || e.param < 0 || e.param >= rosin::engine::paramCount || !std::isfinite(e.min) || !std::isfinite(e.max))
             __builtin_trap();
     // Migrated: every parameter is present.
     int params = 0;

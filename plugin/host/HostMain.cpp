@@ -182,9 +182,8 @@ int main(int argc, char** argv)
                             d.detail.empty() ? "" : ("\n           " + d.detail).c_str());
             std::printf("hot-plug: %s\n", scan.hotplug() ? "libusb tells arrivals and departures" : "not available, polling");
         }
-        auto backend = makeHidapiBackend();
         if (hidSeconds > 0.0) {
-            HidInput input(std::move(backend), makeLibusbWatcher());
+            HidInput input(makeHidapiBackend(), makeLibusbWatcher());
             input.start();
             const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(hidSeconds);
             Event e, last;

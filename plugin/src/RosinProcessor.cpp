@@ -557,15 +557,12 @@ void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
         return;
     }
     for (const auto& m : loaded.hidMappings) hid_->setMapping(m);
-    const auto& entries = loaded.mappings;
-    const juce::String problems = loaded.problem;
-    const auto* xml = loaded.tree.get();
     const int before = juce::roundToInt(instrumentRaw_->load());
-    state_.replaceState(juce::ValueTree::fromXml(*xml));
-    map_.assign(entries);
+    state_.replaceState(juce::ValueTree::fromXml(*loaded.tree));
+    map_.assign(loaded.mappings);
     {
         const std::lock_guard<std::mutex> lock(loadMutex_);
-        stateProblem_ = problems;
+        stateProblem_ = loaded.problem; // what was skipped (a broken HID map), else empty
     }
     // The same instrument keeps its engine (and what it is playing): the parameters reach it
     // through the next block's push. Another instrument is built and swapped in.

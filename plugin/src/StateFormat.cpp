@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rosin/engine/ControllerMap.h"
 #include "rosin/engine/Parameters.h"
 
 namespace rosin::plugin::state {
@@ -22,17 +23,15 @@ juce::String migrate(juce::XmlElement& xml, int current)
                juce::String(current) + "): the current settings are kept";
     // 0 and 1 -> 2, and any state missing parameters (cut short, edited by hand): what it does
     // not hold plays as its default, as older builds without that parameter did.
-    {
-        for (int i = 0; i < engine::paramCount; ++i) {
-            const auto& info = engine::paramInfo(i);
-            const juce::String id(info.id.data(), info.id.size());
-            bool present = false;
-            for (auto* p : xml.getChildWithTagNameIterator("PARAM")) present = present || p->getStringAttribute("id") == id;
-            if (present) continue;
-            auto* p = xml.createNewChildElement("PARAM");
-            p->setAttribute("id", id);
-            p->setAttribute("value", static_cast<double>(info.steps > 0 ? info.def - info.min : info.def));
-        }
+    for (int i = 0; i < engine::paramCount; ++i) {
+        const auto& info = engine::paramInfo(i);
+        const juce::String id(info.id.data(), info.id.size());
+        bool present = false;
+        for (auto* p : xml.getChildWithTagNameIterator("PARAM")) present = present || p->getStringAttribute("id") == id;
+        if (present) continue;
+        auto* p = xml.createNewChildElement("PARAM");
+        p->setAttribute("id", id);
+        p->setAttribute("value", static_cast<double>(info.steps > 0 ? info.def - info.min : info.def));
     }
     xml.setAttribute("format", "rosin-state/" + juce::String(current));
     return {};
@@ -82,7 +81,7 @@ LoadedState read(const void* data, int sizeInBytes, const juce::String& treeType
             e.min = static_cast<float>(m->getDoubleAttribute("min"));
             e.max = static_cast<float>(m->getDoubleAttribute("max"));
             e.invert = m->getBoolAttribute("invert");
-            if (e.cc >= 0 && e.cc < 120 && e.param >= 0 && std::isfinite(e.min) && std::isfinite(e.max)) out.mappings.push_back(e);
+            if (e.cc >= 0 && e.cc < engine::ControllerMap::numControllers && e.param >= 0 && std::isfinite(e.min) && std::isfinite(e.max)) out.mappings.push_back(e);
         }
         xml->removeChildElement(maps, true);
     }
