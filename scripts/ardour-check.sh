@@ -31,6 +31,11 @@ command -v ardour7-lua >/dev/null || { echo "ardour7-lua missing (package ardour
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # Ardour finds VST3 plugins through its scanner's cache, as a DAW user's first scan would.
+# It trusts a cache entry only when it is newer than the module by a whole second (it compares
+# st_mtime in seconds), so a scan in the same second as the install is stale and the plugin is
+# not listed: scan only once the clock has left the module's second.
+module=$(find "$vst3/Rosin.vst3/Contents" -name 'Rosin.so' | head -1)
+while (( $(date +%s) <= $(stat -c %Y "$module") )); do sleep 0.1; done
 HOME="${installed:-$HOME}" LD_LIBRARY_PATH=/usr/lib/ardour7 /usr/lib/ardour7/ardour-vst3-scanner -q -f "$vst3/Rosin.vst3"
 if [[ -n "$installed" ]]; then
   ROSIN_ARDOUR_SESSION="$work/session" HOME="$installed" \
