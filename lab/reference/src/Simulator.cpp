@@ -274,10 +274,13 @@ Sample Simulator::step(double force, double bowSpeed)
     // Contact: footprint from the load law, temperature from the heat of the last step.
     force = std::max(0.0, force);
     const ContactConstants& kc = fr.contact;
-    const double load = force > 0.0 ? kc.referenceLoad * std::pow(force / kc.referenceLoad, fr.loadExponent) : 0.0;
+    auto loadOf = [&](double f) { return f > 0.0 ? kc.referenceLoad * std::pow(f / kc.referenceLoad, fr.loadExponent) : 0.0; };
+    const double load = loadOf(force);
     double theta = 0.0;
     if (fr.law != FrictionLaw::Curve) {
-        const double area = fr.footprintRatio * kPi * kc.radiusAtReference * kc.radiusAtReference * forcePrev_ / kc.referenceLoad;
+        // The heat of the last step spreads over the last step's footprint, which follows the same
+        // load law as the friction (a Hertzian footprint grows as F^n, not as F).
+        const double area = fr.footprintRatio * kPi * kc.radiusAtReference * kc.radiusAtReference * loadOf(forcePrev_) / kc.referenceLoad;
         double heat = 0.0, advection = 0.0, kappa = 0.0;
         if (area > 0.0) {
             const double a = std::sqrt(area / kPi);

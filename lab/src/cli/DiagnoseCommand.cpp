@@ -36,7 +36,7 @@ struct DiagnoseCommand {
     {
         CLI::App* diagnoseCmd = app.add_subcommand("diagnose", "Compare a measurement set with the model, name what it gets wrong, "
                                                                "extend it, and measure the gain on held-out strokes");
-        diagnoseCmd->footer("Writes OUT/diagnosis.json (shared/docs/DIAGNOSIS.md), OUT/report.md and its figures\n"
+        diagnoseCmd->footer("Writes OUT/diagnosis.json (format in docs/diagnosis.md), OUT/report.md and its figures\n"
                             "(maps.png, overlays.png, jumps.png). A broken set is refused before anything is written.");
         diagnoseCmd->add_option("set", diagSet, "Measurement set folder (rosin-measurement/1)")->required();
         diagnoseCmd->add_option("-o,--out", diagOut, "New output folder")->capture_default_str();

@@ -79,6 +79,7 @@ struct Trial {
     double fitError = 0, gain = 0, gainLow = 0, gainHigh = 0; ///< validation error fall (absolute) and its CI
     double relativeGain = 0;   ///< gain / validation error before
     double testGain = 0;       ///< the same fall on the test strokes (judged for the kept one only)
+    double overThermal = 0;    ///< for a candidate that brings thermal memory along: its fall below thermal memory alone, relative
     std::string verdict;       ///< "named", or which rule it failed
     bool kept = false;
 };

@@ -1,7 +1,7 @@
 // USB HID report descriptors: parse what real devices serve (report IDs per report type,
 // usage pages mixed inside one main item, the last usage repeating, sign only when the logical
 // minimum is negative, 4-bit unit exponents, vendor pages, long items) and decode reports.
-// Rules and fixtures: ../shared/docs/CONTROLLERS.md section 1, ../shared/data/hid/README.md.
+// The rules are described in docs/manual.md (HID controllers); fixtures are in tests/data/hid/.
 #pragma once
 #include <cstddef>
 #include <cstdint>
