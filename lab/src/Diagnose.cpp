@@ -68,8 +68,8 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
     for (const char* k : {"tension_scale", "beta_scale"})
         if (m.params.count(k)) {
             c.names.push_back(k);
-            c.lo.push_back(k[0] == 't' ? 0.95 : 0.96);
-            c.hi.push_back(k[0] == 't' ? 1.05 : 1.04);
+            c.lo.push_back(parameterBounds().at(k).first);
+            c.hi.push_back(parameterBounds().at(k).second);
             c.start.push_back(m.params.at(k));
         }
     return c;
@@ -381,9 +381,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             if (t.c.adds.size() > 1) {
                 const auto alone = std::find_if(tried.begin(), tried.end(), [](const Tried& u) { return u.c.effect == "thermal_memory"; });
                 if (alone != tried.end()) {
-                    const auto inc = pairedGain(alone->val, t.val, o.bootstrap, o.seed + static_cast<std::uint64_t>(round * 100 + 77));
                     const double base = mean(alone->val);
-                    trial.overThermal = base > 0 ? inc[0] / base : 0.0;
+                    trial.overThermal = base > 0 ? (base - mean(t.val)) / base : 0.0;
                     if (trial.overThermal < o.namingThreshold) {
                         trial.verdict = "no better than thermal_memory alone";
                         continue;
