@@ -64,17 +64,7 @@ public:
             wait(5); // polls: the audio thread never signals (signalling takes a lock)
             owner_.housekeeping();
             owner_.pollHid();
-            const double rate = owner_.sampleRate_.load();
-            const int wanted = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(owner_.instrumentRaw_->load()));
-            if (rate > 0.0 && wanted != owner_.requestedInstrument_.load()) {
-                try {
-                    owner_.loadInstrument(instrumentNames()[wanted], false);
-                } catch (const std::exception& e) {
-                    DBG("Rosin: " << e.what());
-                    owner_.requestedInstrument_.store(wanted); // do not retry a broken file every few ms
-                    owner_.settledInstrument_.store(wanted);   // an offline render must not wait for it
-                }
-            }
+            owner_.followInstrumentParameter();
         }
     }
 
@@ -213,9 +203,36 @@ void RosinProcessor::loadHidMapping(const juce::String& name)
     hid_->setMapping(hid::HidMapping::fromDocument(library_.open("controllers", name.toStdString(), "")));
 }
 
+int RosinProcessor::wantedInstrument() const noexcept
+{
+    return juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(instrumentRaw_->load()));
+}
+
+void RosinProcessor::followInstrumentParameter()
+{
+    if (sampleRate_.load() <= 0.0 || wantedInstrument() == requestedInstrument_.load()) return;
+    const std::lock_guard<std::mutex> lock(loadMutex_);
+    // Asked again under the lock: a preset loaded meanwhile by another thread has moved the
+    // parameter with it, and a value read before that load would undo the preset.
+    const int wanted = wantedInstrument();
+    if (wanted == requestedInstrument_.load()) return;
+    try {
+        loadInstrumentLocked(instrumentNames()[wanted], false);
+    } catch (const std::exception& e) {
+        DBG("Rosin: " << e.what());
+        requestedInstrument_.store(wanted); // do not retry a broken file every few ms
+        settledInstrument_.store(wanted);   // an offline render must not wait for it
+    }
+}
+
 void RosinProcessor::loadInstrument(const juce::String& name, bool applyDefaults)
 {
     const std::lock_guard<std::mutex> lock(loadMutex_);
+    loadInstrumentLocked(name, applyDefaults);
+}
+
+void RosinProcessor::loadInstrumentLocked(const juce::String& name, bool applyDefaults)
+{
     const int index = instrumentNames().indexOf(name);
     if (index >= 0) requestedInstrument_.store(index);
     const auto preset = presets::loadInstrument(library_, name.toStdString());
@@ -271,7 +288,7 @@ void RosinProcessor::prepareToPlay(double sampleRate, int maximumExpectedSamples
     const std::lock_guard<std::mutex> lock(loadMutex_);
     fadeLength_ = std::max(1, juce::roundToInt(swapFadeSeconds * sampleRate));
     fadeBuffer_.setSize(2, std::max(maximumExpectedSamplesPerBlock, fadeLength_));
-    const int index = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(instrumentRaw_->load()));
+    const int index = wantedInstrument();
     // A pending engine never played: it is retired (the housekeeping thread frees it).
     if (engine::Synth* pending = engines_.takePending()) {
         if (!engines_.retire(pending)) delete pending; // the queue is full: nobody else can hold it now
@@ -566,7 +583,7 @@ void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
     }
     // The same instrument keeps its engine (and what it is playing): the parameters reach it
     // through the next block's push. Another instrument is built and swapped in.
-    const int index = juce::jlimit(0, instrumentNames().size() - 1, juce::roundToInt(instrumentRaw_->load()));
+    const int index = wantedInstrument();
     if (index == before && requestedInstrument_.load() == index) return;
     try {
         loadInstrument(instrumentNames()[index], false);

@@ -119,6 +119,10 @@ private:
     void gatherEvents(const juce::MidiBuffer& midi, int numSamples) noexcept;
     void hidEvents(int numSamples) noexcept;
     void renderCurrent(float* left, float* right, int from, int to) noexcept;
+    int wantedInstrument() const noexcept; ///< the instrument parameter, as an index
+    /// [housekeeping thread] Builds the instrument the parameter names when it moved.
+    void followInstrumentParameter();
+    void loadInstrumentLocked(const juce::String& name, bool applyDefaults); ///< loadMutex_ held
     void addEvent(const engine::ControlEvent& e) noexcept;
     void handle(engine::Synth& synth, const engine::ControlEvent& e) noexcept;
     void pushParameters(engine::Synth& synth, bool all) noexcept;
