@@ -5,9 +5,11 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <functional>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -56,6 +58,38 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
 
 /// What a lab never knows exactly and diagnosis fits as calibration, not as a finding.
 inline bool isNuisance(const std::string& p) { return p == "tension_scale" || p == "beta_scale"; }
+
+class Engine;
+
+/// One extension the diagnosis may try: the effects it adds and the parameters it fits.
+struct Candidate {
+    std::string effect;
+    std::vector<std::string> adds, names;
+    std::vector<double> lo, hi, start;
+    std::size_t scanned = 0; ///< the grid covers the first `scanned` parameters (0: all); the rest start where they are
+};
+
+/// Bounds of every parameter any extension has (for the joint refit).
+const std::map<std::string, std::pair<double, double>>& parameterBounds();
+/// The candidate with the model's nuisances, and the parameters of effects already named, free too.
+Candidate withNuisances(Candidate c, const EffectModel& m);
+/// The extensions not yet in m (rate dependence and the rosin shift bring thermal memory along).
+std::vector<Candidate> candidates(const EffectModel& m);
+/// True when the fitted parameters put the effect at its own absence.
+bool atNull(const std::string& effect, const std::map<std::string, double>& p);
+/// Which effect a parameter belongs to ("calibration" for the nuisances).
+std::string effectOf(const std::string& parameter);
+/// The model base with the candidate's effects added and its parameters set to x.
+EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x);
+/// Fits the candidate's parameters on the strokes `on`: a coarse grid, then COBYLA from its best point.
+std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<std::size_t>& on,
+                        std::vector<double> start, int maxEval, double step, double* best = nullptr, bool scan = true);
+/// Paired bootstrap of the mean of before - after: {mean, low, high} (95 %).
+std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after, int B, std::uint64_t seed);
+/// True when [lo, hi] reaches the parameter's no-effect value.
+bool intervalAtNull(const std::string& name, double lo, double hi);
+/// The strokes of `from` in the upper (or lower) half of bow acceleration.
+std::vector<std::size_t> subset(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes, bool upper);
 
 /// Covariance of x by the local curvature: residuals r(x), Jacobian by central differences with
 /// the given steps, s^2 (J^T J)^-1 with s^2 = |r|^2 / (n - p); unconstrained directions get a
