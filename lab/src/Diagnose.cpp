@@ -33,6 +33,16 @@ std::string EffectModel::name() const
     return n;
 }
 
+std::string effectOfParameter(const std::string& parameter)
+{
+    if (parameter == "r_A") return "thermal_memory";
+    if (parameter == "h0" || parameter == "p") return "rate_dependence";
+    if (parameter == "load_exponent") return "hertzian_contact";
+    if (parameter == "shift_k") return "rosin_temperature_shift";
+    if (parameter == "zt_ratio") return "torsional_compliance";
+    return "calibration";
+}
+
 using namespace diag;
 
 Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const std::function<void(const std::string&, double)>& progress)
@@ -94,7 +104,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     EffectModel current;
     if (o.fitNuisances) {
         say("calibration: tension and bow position", 0.0);
-        Candidate cal{"calibration", {}, {"tension_scale", "beta_scale"}, {0.95, 0.96}, {1.05, 1.04}, {1.0, 1.0}};
+        Candidate cal = candidate("calibration", {"tension_scale", "beta_scale"}, {1.0, 1.0});
+        cal.adds.clear(); // calibration is not an effect
         const auto x = diag::fit(engine, current, cal, fitSet, cal.start, o.maxEvaluations, 0.2);
         current = apply(current, cal, x);
     }
@@ -267,7 +278,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             Finding finding;
             finding.effect = effect;
             for (const auto& name : best->c.names)
-                if (effectOf(name) == effect) {
+                if (effectOfParameter(name) == effect) {
                     const double v = current.params[name];
                     finding.parameters[name] = {v, v - halfWidth[name], v + halfWidth[name]};
                 }

@@ -42,6 +42,17 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
     return c;
 }
 
+/// A candidate whose parameters take their bounds from parameterBounds().
+Candidate candidate(const std::string& effect, std::vector<std::string> names, std::vector<double> start)
+{
+    Candidate c{effect, {effect}, std::move(names), {}, {}, std::move(start)};
+    for (const auto& name : c.names) {
+        c.lo.push_back(parameterBounds().at(name).first);
+        c.hi.push_back(parameterBounds().at(name).second);
+    }
+    return c;
+}
+
 std::vector<Candidate> candidates(const EffectModel& m)
 {
     std::vector<Candidate> out;
@@ -50,19 +61,17 @@ std::vector<Candidate> candidates(const EffectModel& m)
         if (!thermal) {
             c.adds.insert(c.adds.begin(), "thermal_memory");
             c.names.insert(c.names.begin(), "r_A");
-            c.lo.insert(c.lo.begin(), 0.5);
-            c.hi.insert(c.hi.begin(), 2.0);
+            c.lo.insert(c.lo.begin(), parameterBounds().at("r_A").first);
+            c.hi.insert(c.hi.begin(), parameterBounds().at("r_A").second);
             c.start.insert(c.start.begin(), 1.0);
         }
         return c;
     };
-    if (!thermal) out.push_back({"thermal_memory", {"thermal_memory"}, {"r_A"}, {0.5}, {2.0}, {1.0}});
-    if (!has(m.effects, "rate_dependence"))
-        out.push_back(withRA({"rate_dependence", {"rate_dependence"}, {"h0", "p"}, {0.3, 0.1}, {1.2, 0.8}, {0.563, 0.4}}));
-    if (!has(m.effects, "hertzian_contact")) out.push_back({"hertzian_contact", {"hertzian_contact"}, {"load_exponent"}, {0.4}, {1.1}, {0.8}});
-    if (!has(m.effects, "rosin_temperature_shift"))
-        out.push_back(withRA({"rosin_temperature_shift", {"rosin_temperature_shift"}, {"shift_k"}, {-30.0}, {30.0}, {0.0}}));
-    if (!has(m.effects, "torsional_compliance")) out.push_back({"torsional_compliance", {"torsional_compliance"}, {"zt_ratio"}, {0.7}, {8.0}, {2.0}});
+    if (!thermal) out.push_back(candidate("thermal_memory", {"r_A"}, {1.0}));
+    if (!has(m.effects, "rate_dependence")) out.push_back(withRA(candidate("rate_dependence", {"h0", "p"}, {0.563, 0.4})));
+    if (!has(m.effects, "hertzian_contact")) out.push_back(candidate("hertzian_contact", {"load_exponent"}, {0.8}));
+    if (!has(m.effects, "rosin_temperature_shift")) out.push_back(withRA(candidate("rosin_temperature_shift", {"shift_k"}, {0.0})));
+    if (!has(m.effects, "torsional_compliance")) out.push_back(candidate("torsional_compliance", {"zt_ratio"}, {2.0}));
     return out;
 }
 
@@ -87,17 +96,6 @@ bool atNull(const std::string& effect, const std::map<std::string, double>& p)
     if (effect == "torsional_compliance") return get("zt_ratio") > 7.0;
     if (effect == "rate_dependence") return get("p") < 0.12;
     return false;
-}
-
-/// Which parameters belong to which effect (for splitting a two-effect step into findings).
-std::string effectOf(const std::string& parameter)
-{
-    if (parameter == "r_A") return "thermal_memory";
-    if (parameter == "h0" || parameter == "p") return "rate_dependence";
-    if (parameter == "load_exponent") return "hertzian_contact";
-    if (parameter == "shift_k") return "rosin_temperature_shift";
-    if (parameter == "zt_ratio") return "torsional_compliance";
-    return "calibration";
 }
 
 EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x)

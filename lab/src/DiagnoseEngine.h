@@ -71,14 +71,14 @@ struct Candidate {
 
 /// Bounds of every parameter any extension has (for the joint refit).
 const std::map<std::string, std::pair<double, double>>& parameterBounds();
+/// A candidate adding `effect` with the given parameters, bounded by parameterBounds().
+Candidate candidate(const std::string& effect, std::vector<std::string> names, std::vector<double> start);
 /// The candidate with the model's nuisances, and the parameters of effects already named, free too.
 Candidate withNuisances(Candidate c, const EffectModel& m);
 /// The extensions not yet in m (rate dependence and the rosin shift bring thermal memory along).
 std::vector<Candidate> candidates(const EffectModel& m);
 /// True when the fitted parameters put the effect at its own absence.
 bool atNull(const std::string& effect, const std::map<std::string, double>& p);
-/// Which effect a parameter belongs to ("calibration" for the nuisances).
-std::string effectOf(const std::string& parameter);
 /// The model base with the candidate's effects added and its parameters set to x.
 EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x);
 /// Fits the candidate's parameters on the strokes `on`: a coarse grid, then COBYLA from its best point.

@@ -33,15 +33,6 @@ const std::vector<std::string>& parameterNames()
     return p;
 }
 
-std::string effectOfParameter(const std::string& p)
-{
-    if (p == "r_A") return "thermal_memory";
-    if (p == "h0" || p == "p") return "rate_dependence";
-    if (p == "load_exponent") return "hertzian_contact";
-    if (p == "shift_k") return "rosin_temperature_shift";
-    return "torsional_compliance";
-}
-
 /// How far an effect is from its own absence, for detection against size (thermal memory has
 /// no such value: the thermal law is a different law, not a parameter's end).
 double effectSize(const std::string& effect, const std::map<std::string, double>& truth)

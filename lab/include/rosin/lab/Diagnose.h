@@ -22,6 +22,10 @@ struct EffectModel {
     std::string name() const; ///< friction_curve, thermal or enhanced (+ hertz, torsion, shift)
 };
 
+/// The effect a model parameter belongs to (r_A: thermal_memory, load_exponent: hertzian_contact,
+/// ...); "calibration" for anything else (the nuisances).
+std::string effectOfParameter(const std::string& parameter);
+
 /// What is compared per stroke (PHYSICS.md 7.1), from a bridge force in newtons that starts
 /// at the gesture start, sampled at the diagnosis rate.
 struct StrokeFeatures {
