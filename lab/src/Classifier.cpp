@@ -119,6 +119,11 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
     // pays for its parameters (BIC), so a clean ramp is not bent by a fitted hum and a DC.
     std::vector<double> hums{0.0, 50.0, 60.0};
     if (in.hum >= 0.0) hums = {in.hum};
+    // A hum is fitted only over at least one of its periods: over a shorter window its sines
+    // and their harmonics stand in for the ramp and come out huge and cancelling, and taking
+    // them out of the whole record writes a false 50 Hz wave into it.
+    std::erase_if(hums, [&](double hum) { return hum > 0.0 && end < fs / hum; });
+    if (hums.empty()) hums = {0.0};
     for (double hum : hums) {
         const int harmonics = hum > 0.0 ? 4 : 0;
         // Trigger search: coarse grid over the pre-slip time, then refined around the best.
@@ -132,7 +137,7 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
                 std::vector<std::vector<double>> cols(2 + 2 * harmonics, std::vector<double>(static_cast<std::size_t>(end)));
                 for (int i = 0; i < end; ++i) {
                     cols[0][i] = 1.0;
-                    cols[1][i] = stiffness * xb[i];
+                    cols[1][i] = in.rampShape ? (i / fs > t0 ? in.rampShape(i / fs - t0) : 0.0) : stiffness * xb[i];
                     for (int h = 1; h <= harmonics; ++h) {
                         cols[2 * h][i] = std::sin(2 * std::numbers::pi * hum * h * i / fs);
                         cols[2 * h + 1][i] = std::cos(2 * std::numbers::pi * hum * h * i / fs);
@@ -140,7 +145,7 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
                 }
                 std::vector<double> y(f.begin(), f.begin() + end);
                 std::vector<double> c;
-                if (in.knownGain > 0.0) {
+                if (in.knownGain > 0.0 && !in.rampShape) {
                     // Gain known: subtract the ramp, fit only DC and hum.
                     for (int i = 0; i < end; ++i) y[i] -= in.knownGain * cols[1][i];
                     std::vector<std::vector<double>> rest(cols);
@@ -161,7 +166,8 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
                 if (r < passBest) { passBest = r; passT0 = t0; }
                 if (bic < bestResidual && c[1] > 0.0) {
                     bestResidual = bic;
-                    best.gain = c[1];
+                    // A shape's factor is not the gain: the gain is the known one, or stays 1.
+                    best.gain = in.rampShape ? (in.knownGain > 0.0 ? in.knownGain : 1.0) : c[1];
                     best.dc = c[0];
                     best.trigger = t0;
                     best.hum = hum;
@@ -188,7 +194,7 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
         for (int i = 0; i < rest; ++i) still[static_cast<std::size_t>(i)] = f[static_cast<std::size_t>(i)] - best.humWave[static_cast<std::size_t>(i)];
         std::nth_element(still.begin(), still.begin() + rest / 2, still.end());
         best.dc = still[static_cast<std::size_t>(rest / 2)];
-        if (in.knownGain <= 0.0) {
+        if (in.knownGain <= 0.0 && !in.rampShape) {
             const auto xb = bowDisplacement(in.bowSpeed, fs, end, best.trigger);
             double num = 0.0, den = 0.0;
             for (int i = 0; i < end; ++i) {

@@ -60,7 +60,6 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     if (!set.tension) d.warnings.push_back("rig.string.tension_n missing: assumed " + std::to_string(info.tension) + " N (cello D)");
     if (!set.length) d.warnings.push_back("rig.string.length_m missing: assumed " + std::to_string(info.length) + " m (cello D)");
     info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
-    if (set.gesture != "guettler") throw LabError(set.folder.string() + ": diagnose handles gesture.kind \"guettler\" sets for now");
 
     // 1. Clean every recording, find its gesture start, convert the set to newtons.
     say("preparing", 0.0);
@@ -119,8 +118,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                    " % of the validation error (threshold calibrated on null sets), and a candidate that brings thermal memory along "
                    "(rate dependence, a rosin shift) also falls below thermal memory alone by that share, (3) it also lowers the error of the test strokes, "
                    "(4) the 95 % interval of its parameter (bootstrap refits) excludes the no-effect value (exponent 1, shift 0 K, "
-                   "Z_t/Z_0 >= 7.5, speed exponent <= 0.03), and (5) refitted on the low- and on the high-acceleration half of the fit "
-                   "strokes it keeps away from the no-effect value with consistent values. Every candidate is fitted with the nuisances and the "
+                   "Z_t/Z_0 >= 7.5, speed exponent <= 0.03), and (5) refitted on the low- and on the high-drive half of the fit strokes "
+                   "(bow acceleration; v0/tv for exp_speed and bow speed for exp_force strokes, each gesture split at its own median) it keeps away from the no-effect value with consistent values. Every candidate is fitted with the nuisances and the "
                    "parameters of effects already named free beside its own.",
                "The reported gain compares the calibrated baseline and the final model on the test strokes only."};
 
@@ -232,7 +231,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 if (spread > 2.0 * halfWidth[t.c.names[k]] + 0.1 * (t.c.hi[k] - t.c.lo[k])) halvesAgree = false;
             }
             if (atNull(t.c.effect, lowFit) || atNull(t.c.effect, highFit) || !halvesAgree) {
-                trial.verdict = "not consistent on the two acceleration halves";
+                trial.verdict = "not consistent on the two drive halves (bow acceleration, or the gesture's own drive)";
                 continue;
             }
             trial.verdict = "named";
@@ -335,7 +334,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     // 4. What the report shows: every stroke under the baseline and the final model.
     say("report", 0.0);
     d.ids.resize(n);
-    d.accel.resize(n);
+    d.gestures.resize(n);
+    d.drive.resize(n);
     d.force.resize(n);
     d.measured.resize(n);
     d.baselineSim.resize(n);
@@ -345,7 +345,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     d.finalForce.resize(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
         d.ids[i] = strokes[i].id;
-        d.accel[i] = strokes[i].a;
+        d.gestures[i] = strokes[i].kind;
+        d.drive[i] = strokes[i].drive;
         d.force[i] = strokes[i].F;
         d.measured[i] = strokes[i].feat;
         d.baselineSim[i] = engine.simulate(d.baseline, i, &d.baselineForce[i]);

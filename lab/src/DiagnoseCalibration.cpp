@@ -92,18 +92,26 @@ SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts)
     return out;
 }
 
-/// One of two disjoint halves of the fit strokes: below or above their median bow acceleration.
-/// (Halves by force would take away the lever arm a load exponent is measured on.)
-
 std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo& info, const DiagnoseOptions& o, Diagnosis& d)
 {
     // 1. Clean every recording and find its gesture start; one gain for the whole set.
     const std::size_t n = set.strokes.size();
+    const bool anyStick = std::any_of(set.strokes.begin(), set.strokes.end(), [](const MeasuredStroke& s) { return s.gesture != "exp_force"; });
+    if (set.units == "V" && !anyStick)
+        throw LabError(set.folder.string() + ": rig.sensor.units is \"V\" but every transient is an exp_force stroke, whose pre-slip "
+                       "force carries the friction level as well as the sensor's scale: calibrate the sensor (units \"N\") or "
+                       "add guettler or exp_speed strokes, whose pre-slip ramps set the scale");
+
     std::vector<Calibration> cal(n);
     // knownGain 0: gain fitted per recording.
     auto recording = [&](std::size_t i, double knownGain) {
         const MeasuredStroke& s = set.strokes[i];
-        ClassifierInput in = guettlerStrokeInput(s.signal, set.sampleRate, info.f0, info.beta, info.z0, info.tension, info.length, s.accel);
+        ClassifierInput in = guettlerStrokeInput(s.signal, set.sampleRate, info.f0, info.beta, info.z0, info.tension, info.length, 0.0);
+        const Gesture g = strokeGesture(s, info.beta);
+        in.bowSpeed = [g](double t) { return g.at(t).speed; };
+        // A rising force at full bow speed slides from the start: its pre-slip force follows
+        // the force's rise times a friction level, which says nothing of the sensor's scale.
+        if (s.gesture == "exp_force") in.rampShape = [g](double t) { return g.at(t).force; };
         in.measured = true;
         in.knownGain = knownGain;
         return in;
@@ -114,8 +122,14 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     });
     std::vector<double> gains, allGains;
     int unfitted = 0;
+    bool shapesFitted = false;
     for (std::size_t i = 0; i < n; ++i) {
         if (cal[i].firstSlip < 0) continue;
+        if (set.strokes[i].gesture == "exp_force") {
+            if (!cal[i].rampFitted) ++unfitted;
+            else shapesFitted = true;
+            continue; // its ramp's factor is not a gain
+        }
         if (!cal[i].rampFitted) {
             ++unfitted;
             continue;
@@ -125,7 +139,7 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
         if (cal[i].firstSlip / set.sampleRate - cal[i].trigger > 4.0 / info.f0) gains.push_back(cal[i].gain);
     }
     // The gesture starts were estimated, not taken as the file starts, when any ramp fitted.
-    d.triggersDetected = !allGains.empty();
+    d.triggersDetected = !allGains.empty() || shapesFitted;
     if (unfitted > 0)
         d.warnings.push_back(std::to_string(unfitted) + " stroke(s) slipped before a pre-slip ramp could be fitted: their gesture start is taken as the file start");
     double gain = median(gains.size() >= 3 ? gains : allGains);
@@ -164,8 +178,10 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
         const MeasuredStroke& s = set.strokes[i];
         Prepared& p = strokes[i];
         p.id = s.id;
-        p.a = s.accel;
-        p.F = s.force;
+        p.gesture = strokeGesture(s, info.beta);
+        p.kind = s.gesture;
+        p.drive = gestureDrive(s);
+        p.F = gestureForce(s);
         const auto from = static_cast<std::size_t>(std::max(0.0, cal[i].trigger) * set.sampleRate);
         std::vector<double> f;
         // Unfitted strokes are in signal units: the set's gain converts them.
@@ -175,7 +191,7 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
         f.resize(std::min(f.size(), static_cast<std::size_t>(0.5 * o.simRate)));
         p.force = std::move(f);
         p.noise = noiseLevel(p.force);
-        p.feat = features(p.force, o.simRate, p.a, p.F, info, true);
+        p.feat = features(p.force, o.simRate, p.gesture, info, true);
     });
 
 

@@ -3,6 +3,7 @@
 #include <nlopt.hpp>
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -196,15 +197,26 @@ bool intervalAtNull(const std::string& name, double lo, double hi)
     return false;
 }
 
+std::vector<bool> upperDriveHalf(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes)
+{
+    std::map<std::string, std::vector<double>> drives;
+    for (auto i : from) drives[strokes[i].kind].push_back(strokes[i].drive);
+    std::map<std::string, double> mid;
+    for (auto& [kind, d] : drives) {
+        std::sort(d.begin(), d.end());
+        mid[kind] = d[d.size() / 2];
+    }
+    std::vector<bool> upper;
+    for (auto i : from) upper.push_back(strokes[i].drive >= mid[strokes[i].kind]);
+    return upper;
+}
+
 std::vector<std::size_t> subset(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes, bool upper)
 {
-    std::vector<double> a;
-    for (auto i : from) a.push_back(strokes[i].a);
-    std::sort(a.begin(), a.end());
-    const double mid = a[a.size() / 2];
+    const std::vector<bool> high = upperDriveHalf(from, strokes);
     std::vector<std::size_t> out;
-    for (auto i : from)
-        if ((strokes[i].a >= mid) == upper) out.push_back(i);
+    for (std::size_t k = 0; k < from.size(); ++k)
+        if (high[k] == upper) out.push_back(from[k]);
     return out;
 }
 

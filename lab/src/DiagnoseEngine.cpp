@@ -23,10 +23,12 @@ double noiseLevel(const std::vector<double>& f)
     return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
 }
 
-StrokeFeatures features(std::vector<double> f, double fs, double a, double F, const StringInfo& s, bool recorded)
+StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, bool recorded)
 {
     zeroPhaseLowPass(f, kCompareCutoff, fs);
-    const ClassifierInput in = guettlerStrokeInput(f, fs, s.f0, s.beta, s.z0, s.tension, s.length, a);
+    ClassifierInput in = guettlerStrokeInput(f, fs, s.f0, s.beta, s.z0, s.tension, s.length, 0.0);
+    in.bowSpeed = [g](double t) { return g.at(t).speed; };
+    const double F = g.force; // the final force of a rising-force stroke
     ClassifierSettings st;
     // A first slip drops the force by more than 2 % of the bow force, and in a recording by
     // clearly more than its noise can within 0.1 ms.
@@ -49,8 +51,9 @@ StrokeFeatures features(std::vector<double> f, double fs, double a, double F, co
     return r;
 }
 
-ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, double a, double F, const StringInfo& info)
+ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info)
 {
+    const double F = g.force;
     ErrorParts e;
     if (m.firstSlip < 0 && s.firstSlip < 0) return e;
     if (m.firstSlip < 0 || s.firstSlip < 0) return {1, 1, 1, 1, 1};
@@ -63,7 +66,7 @@ ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, double a, d
     if (n > 0) {
         double acc = 0;
         for (std::size_t i = 0; i < n; ++i) acc += (m.wave[i] - s.wave[i]) * (m.wave[i] - s.wave[i]);
-        const double flyback = 2.0 * info.z0 * a * m.firstSlip / info.beta;
+        const double flyback = 2.0 * info.z0 * g.at(m.firstSlip).speed / info.beta;
         e.waveform = std::min(1.0, std::sqrt(acc / static_cast<double>(n)) / std::max(flyback, 1e-9));
     }
     return e;
@@ -108,9 +111,12 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
     }
     dsp::BowedString<double>& s = *v.string;
     const Prepared& p = strokes_[i];
-    const double F = p.F * (1.0 + jitterF), a = p.a * (1.0 + jitterA), b = beta(m);
+    const double b = beta(m);
     std::vector<double> out(p.force.size());
-    for (std::size_t n = 0; n < out.size(); ++n) out[n] = s.processSample(F, a * static_cast<double>(n) / fs_, b);
+    for (std::size_t n = 0; n < out.size(); ++n) {
+        const auto c = p.gesture.at(static_cast<double>(n) / fs_);
+        out[n] = s.processSample(c.force * (1.0 + jitterF), c.speed * (1.0 + jitterA), b);
+    }
     ++simulations_;
     if (head) head->assign(out.begin(), out.begin() + static_cast<long>(std::min(out.size(), static_cast<std::size_t>(12.0 * fs_ / info_.f0 + 0.02 * fs_))));
     if (p.noise > 0.0) {
@@ -118,7 +124,7 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
         std::normal_distribution<double> g(0.0, p.noise);
         for (double& x : out) x += g(rng);
     }
-    return features(std::move(out), fs_, p.a, p.F, info_, true);
+    return features(std::move(out), fs_, p.gesture, info_, true);
 }
 
 std::vector<ErrorParts> Engine::errors(const EffectModel& m, const std::vector<std::size_t>& which) const
@@ -126,7 +132,7 @@ std::vector<ErrorParts> Engine::errors(const EffectModel& m, const std::vector<s
     std::vector<ErrorParts> e(which.size());
     tbb::parallel_for(std::size_t(0), which.size(), [&](std::size_t k) {
         const std::size_t i = which[k];
-        e[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].a, strokes_[i].F, info_);
+        e[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].gesture, info_);
     });
     return e;
 }

@@ -27,7 +27,9 @@ struct StringInfo {
 
 struct Prepared {
     std::string id;
-    double a = 0, F = 0;
+    Gesture gesture;           ///< as the manifest states it (t = 0 at the gesture start)
+    std::string kind;          ///< guettler, exp_speed or exp_force
+    double drive = 0, F = 0;   ///< the stroke's place in its gesture plane (gestureDrive(), gestureForce())
     std::vector<double> force; ///< N at the diagnosis rate, t = 0 at the gesture start
     double noise = 0;          ///< rms noise of the recording (N), added to its simulations
     StrokeFeatures feat;
@@ -37,8 +39,10 @@ constexpr double kCompareCutoff = 5000.0; // both signals see the same low-pass 
 
 /// Noise of a low-passed recording: the robust spread of its sample-to-sample steps.
 double noiseLevel(const std::vector<double>& f);
-StrokeFeatures features(std::vector<double> f, double fs, double a, double F, const StringInfo& s, bool recorded = false);
-ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, double a, double F, const StringInfo& info);
+StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, bool recorded = false);
+/// Per-part disagreement of simulated features s with measured m, for a stroke of gesture g: the
+/// waveform is measured against the flyback the bow speed at the measured first slip would give.
+ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info);
 double mean(const std::vector<ErrorParts>& e);
 inline double median(std::vector<double> v)
 {
@@ -88,8 +92,12 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
 std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after, int B, std::uint64_t seed);
 /// True when [lo, hi] reaches the parameter's no-effect value.
 bool intervalAtNull(const std::string& name, double lo, double hi);
-/// The strokes of `from` in the upper (or lower) half of bow acceleration.
+/// The strokes of `from` in the upper (or lower) half of their gesture's drive (bow acceleration
+/// for Guettler strokes); the median is taken per gesture kind, so a mixed set splits evenly.
+/// (Halves by force would take away the lever arm a load exponent is measured on.)
 std::vector<std::size_t> subset(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes, bool upper);
+/// For each stroke of `from`: is its drive at or above the median of its gesture kind?
+std::vector<bool> upperDriveHalf(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes);
 
 /// Covariance of x by the local curvature: residuals r(x), Jacobian by central differences with
 /// the given steps, s^2 (J^T J)^-1 with s^2 = |r|^2 / (n - p); unconstrained directions get a

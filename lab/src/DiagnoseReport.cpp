@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "DiagnoseEngine.h"
+#include <map>
 #include <set>
 
 #include "rosin/lab/Diagnose.h"
@@ -19,21 +20,40 @@ using nlohmann::json;
 
 namespace {
 
-/// The strokes' verdicts as a Guettler map (axes = the distinct accelerations and forces).
-SweepResult asMap(const Diagnosis& d, const std::vector<StrokeFeatures>& feats, const std::string& label)
+/// The gesture the maps show: Guettler strokes when the set has them, else its commonest kind.
+std::string mapGesture(const Diagnosis& d)
+{
+    std::map<std::string, int> count;
+    for (const auto& g : d.gestures) ++count[g];
+    if (count.count("guettler")) return "guettler";
+    std::string best;
+    for (const auto& [g, c] : count)
+        if (best.empty() || c > count[best]) best = g;
+    return best;
+}
+
+/// The verdicts of the strokes of one gesture as a Guettler map (axes = their distinct drives
+/// and forces).
+SweepResult asMap(const Diagnosis& d, const std::vector<StrokeFeatures>& feats, const std::string& label, const std::string& gesture)
 {
     SweepResult r;
-    std::set<double> A(d.accel.begin(), d.accel.end()), F(d.force.begin(), d.force.end());
+    std::set<double> A, F;
+    for (std::size_t i = 0; i < d.drive.size(); ++i)
+        if (d.gestures[i] == gesture) {
+            A.insert(d.drive[i]);
+            F.insert(d.force[i]);
+        }
     r.spec.accelerations.assign(A.begin(), A.end());
     r.spec.forces.assign(F.begin(), F.end());
     r.spec.label = label;
     r.cells.resize(A.size() * F.size());
     for (auto& c : r.cells) c.regime = Regime::NoSlip;
     for (std::size_t i = 0; i < feats.size(); ++i) {
-        const auto ia = static_cast<std::size_t>(std::distance(r.spec.accelerations.begin(), std::find(r.spec.accelerations.begin(), r.spec.accelerations.end(), d.accel[i])));
+        if (d.gestures[i] != gesture) continue;
+        const auto ia = static_cast<std::size_t>(std::distance(r.spec.accelerations.begin(), std::find(r.spec.accelerations.begin(), r.spec.accelerations.end(), d.drive[i])));
         const auto iF = static_cast<std::size_t>(std::distance(r.spec.forces.begin(), std::find(r.spec.forces.begin(), r.spec.forces.end(), d.force[i])));
         CellResult& c = r.cells[iF * A.size() + ia];
-        c.acceleration = d.accel[i];
+        c.acceleration = d.drive[i];
         c.force = d.force[i];
         c.transientPeriods = feats[i].transientPeriods;
         c.regime = feats[i].regime;
@@ -66,7 +86,12 @@ void overlays(const fs::path& file, const Diagnosis& d)
         ax.line(t, d.finalForce[i], colors::blue, 1.0);
         ax.line(t, m, colors::black, 1.2);
         char title[160];
-        std::snprintf(title, sizeof title, "stroke %s: a = %.2f m/s2, F = %.2f N", d.ids[i].c_str(), d.accel[i], d.force[i]);
+        if (d.gestures[i] == "exp_speed")
+            std::snprintf(title, sizeof title, "stroke %s: v0/tv = %.2f m/s2, F = %.2f N", d.ids[i].c_str(), d.drive[i], d.force[i]);
+        else if (d.gestures[i] == "exp_force")
+            std::snprintf(title, sizeof title, "stroke %s: v = %.2f m/s, F0 = %.2f N", d.ids[i].c_str(), d.drive[i], d.force[i]);
+        else
+            std::snprintf(title, sizeof title, "stroke %s: a = %.2f m/s2, F = %.2f N", d.ids[i].c_str(), d.drive[i], d.force[i]);
         ax.frame(title, "time from the gesture start (ms)", "bridge force (N)");
         if (k == 0) ax.legend({{"measured", colors::black}, {"baseline: " + d.baseline.name(), colors::red}, {"final: " + d.final.name(), colors::blue}});
     }
@@ -228,10 +253,13 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         canvas.save(dir / "loops.png");
     }
 
-    const SweepResult measured = asMap(d, d.measured, "measured"), base = asMap(d, d.baselineSim, "baseline: " + d.baseline.name()),
-                      fin = asMap(d, d.finalSim, "final: " + d.final.name());
+    const std::string shown = mapGesture(d);
+    const SweepResult measured = asMap(d, d.measured, "measured", shown), base = asMap(d, d.baselineSim, "baseline: " + d.baseline.name(), shown),
+                      fin = asMap(d, d.finalSim, "final: " + d.final.name(), shown);
     DiagramOptions dopt;
     dopt.bounds = false;
+    if (shown == "exp_speed") dopt.xLabel = "initial bow acceleration v0/tv (m/s\u00b2)";
+    if (shown == "exp_force") dopt.xLabel = "bow speed (m/s)";
     writePanelPng(dir / "maps.png", {measured, base, fin}, {"measured", "baseline: " + d.baseline.name(), "final: " + d.final.name()}, 3, dopt);
     overlays(dir / "overlays.png", d);
     jumps(dir / "jumps.png", d);
@@ -265,7 +293,10 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         md << "\n";
     }
     const BoundaryFit bm = fitLowerBoundary(measured), bb = fitLowerBoundary(base), bf = fitLowerBoundary(fin);
-    md << "## Guettler maps\n\n![maps](maps.png)\n\nHelmholtz cells: measured " << measured.successCount() << ", baseline "
+    md << "## Guettler maps\n\n![maps](maps.png)\n\n";
+    if (std::any_of(d.gestures.begin(), d.gestures.end(), [&](const std::string& g) { return g != shown; }))
+        md << "The maps show the set's " << shown << " strokes; its other strokes are in every error and fit above but not on the maps.\n\n";
+    md << "Helmholtz cells: measured " << measured.successCount() << ", baseline "
        << base.successCount() << ", final " << fin.successCount() << " of " << measured.cells.size() << ". Lower-boundary exponent p: measured "
        << (bm.valid ? fmt(bm.p) : "n/a") << ", baseline " << (bb.valid ? fmt(bb.p) : "n/a") << ", final " << (bf.valid ? fmt(bf.p) : "n/a") << ".\n\n";
     md << "## Waveforms\n\n![overlays](overlays.png)\n\n## First-slip jumps\n\n![jumps](jumps.png)\n\n";

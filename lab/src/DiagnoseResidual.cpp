@@ -24,7 +24,7 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
             std::uniform_real_distribution<double> j(-0.01, 0.01);
             const StrokeFeatures a = engine.simulate(current, i, nullptr, j(jr), j(jr), 1);
             const StrokeFeatures b = engine.simulate(current, i, nullptr, j(jr), j(jr), 2);
-            floorParts[k] = compare(a, b, strokes[i].a, strokes[i].F, engine.info());
+            floorParts[k] = compare(a, b, strokes[i].gesture, engine.info());
         });
         Residual r;
         r.error = mean(currentTest);
@@ -47,23 +47,30 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
             r.partFloor[names[q]] = partFloor[q] / static_cast<double>(testSet.size());
             if (excess > 0.005) r.parts[names[q]] = excess;
         }
-        // Where: the quadrant of the Guettler plane (bow acceleration x force) with the largest excess.
-        std::vector<double> as, fs;
-        for (auto i : testSet) { as.push_back(strokes[i].a); fs.push_back(strokes[i].F); }
-        const double am = median(as), fm = median(fs);
+        // Where: the quadrant of the Guettler plane (bow acceleration x force; for the other
+        // gestures their drive x force) with the largest excess.
+        const std::vector<bool> highDrive = upperDriveHalf(testSet, strokes);
+        std::vector<double> fs;
+        bool guettlerOnly = true;
+        for (auto i : testSet) {
+            fs.push_back(strokes[i].F);
+            guettlerOnly = guettlerOnly && strokes[i].kind == "guettler";
+        }
+        const double fm = median(fs);
         double worst = -1;
         for (int qa = 0; qa < 2; ++qa)
             for (int qf = 0; qf < 2; ++qf) {
                 double sum = 0;
                 int cnt = 0;
                 for (std::size_t k = 0; k < testSet.size(); ++k)
-                    if ((strokes[testSet[k]].a >= am) == (qa == 1) && (strokes[testSet[k]].F >= fm) == (qf == 1)) {
+                    if (highDrive[k] == (qa == 1) && (strokes[testSet[k]].F >= fm) == (qf == 1)) {
                         sum += currentTest[k].total() - floorParts[k].total();
                         ++cnt;
                     }
                 if (cnt > 0 && sum / cnt > worst) {
                     worst = sum / cnt;
-                    r.where = std::string(qa ? "high" : "low") + " bow acceleration, " + (qf ? "high" : "low") + " bow force";
+                    r.where = std::string(qa ? "high" : "low") + (guettlerOnly ? " bow acceleration, " : " gesture drive (acceleration or speed), ") +
+                              (qf ? "high" : "low") + " bow force";
                 }
             }
         // What it looks like.
@@ -72,8 +79,9 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
         std::vector<double> logV, logF;
         for (auto i : testSet) {
             const StrokeFeatures& m = strokes[i].feat;
-            if (m.firstSlip <= 0) continue;
-            logV.push_back(std::log(strokes[i].a * m.firstSlip));
+            // A rising-force stroke's bow speed is set, not reached: it says nothing here.
+            if (m.firstSlip <= 0 || strokes[i].kind == "exp_force") continue;
+            logV.push_back(std::log(strokes[i].gesture.at(m.firstSlip).speed));
             logF.push_back(std::log(strokes[i].F));
             ++cnt;
         }

@@ -59,7 +59,7 @@ void drawGuettler(Canvas& canvas, double left, double top, double width, double 
                       return n;
                   }(),
                   A.size() * F.size());
-    ax.frame(title, "bow acceleration (m/s\u00b2)", "bow force (N)");
+    ax.frame(title, o.xLabel, "bow force (N)");
     if (!legend.empty()) ax.legendBelow(legend);
 }
 

@@ -153,6 +153,37 @@ std::vector<double> readCsvForce(const fs::path& file, double manifestRate)
 
 } // namespace
 
+Gesture strokeGesture(const MeasuredStroke& s, double beta)
+{
+    Gesture g;
+    g.beta = beta;
+    if (s.gesture == "exp_speed") {
+        g.kind = GestureKind::ExpSpeed;
+        g.speed = s.v0;
+        g.timeConstant = s.tv;
+        g.force = s.force;
+    } else if (s.gesture == "exp_force") {
+        g.kind = GestureKind::ExpForce;
+        g.speed = s.speed;
+        g.timeConstant = s.tf;
+        g.force = s.f0;
+    } else {
+        g.kind = GestureKind::Guettler;
+        g.acceleration = s.accel;
+        g.force = s.force;
+    }
+    return g;
+}
+
+double gestureDrive(const MeasuredStroke& s)
+{
+    if (s.gesture == "exp_speed") return s.v0 / s.tv;
+    if (s.gesture == "exp_force") return s.speed;
+    return s.accel;
+}
+
+double gestureForce(const MeasuredStroke& s) { return s.gesture == "exp_force" ? s.f0 : s.force; }
+
 MeasurementSet readMeasurementSet(const fs::path& folder)
 {
     const fs::path manifest = folder / "manifest.json";
@@ -197,8 +228,9 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
     set.sampleRate = positive(sensor, "sample_rate_hz", manifest, "rig.sensor.");
     if (!doc.contains("gesture") || !doc["gesture"].is_object()) fail(manifest, "gesture", "is missing");
     set.gesture = doc["gesture"].value("kind", "");
-    if (set.gesture != "guettler" && set.gesture != "exp_speed" && set.gesture != "exp_force")
-        fail(manifest, "gesture.kind", "must be \"guettler\", \"exp_speed\" or \"exp_force\"");
+    auto strokeKind = [](const std::string& k) { return k == "guettler" || k == "exp_speed" || k == "exp_force"; };
+    if (!strokeKind(set.gesture) && set.gesture != "mixed")
+        fail(manifest, "gesture.kind", "must be \"guettler\", \"exp_speed\", \"exp_force\" or \"mixed\"");
     if (!doc.contains("transients") || !doc["transients"].is_array() || doc["transients"].empty())
         fail(manifest, "transients", "must be a non-empty array");
     std::set<std::string> ids;
@@ -214,10 +246,19 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
         s.file = folder / t["file"].get<std::string>();
         s.channel = t.value("channel", 0);
         if (s.channel < 0) fail(manifest, where + "channel", "must not be negative");
-        if (set.gesture == "guettler") {
+        // A stroke may name its own gesture; in a mixed set every stroke must.
+        s.gesture = set.gesture;
+        if (t.contains("gesture")) {
+            if (!t["gesture"].is_string() || !strokeKind(t["gesture"].get<std::string>()))
+                fail(manifest, where + "gesture", "must be \"guettler\", \"exp_speed\" or \"exp_force\"");
+            s.gesture = t["gesture"].get<std::string>();
+        } else if (set.gesture == "mixed") {
+            fail(manifest, where + "gesture", "is missing (gesture.kind is \"mixed\": each transient names its own)");
+        }
+        if (s.gesture == "guettler") {
             s.accel = positive(t, "accel_m_s2", manifest, where);
             s.force = positive(t, "force_n", manifest, where);
-        } else if (set.gesture == "exp_speed") {
+        } else if (s.gesture == "exp_speed") {
             s.v0 = positive(t, "v0_m_s", manifest, where);
             s.tv = positive(t, "tv_s", manifest, where);
             s.force = positive(t, "force_n", manifest, where);
@@ -301,8 +342,9 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
             sf_write_double(sf, s.signal.data(), static_cast<sf_count_t>(s.signal.size()));
             sf_close(sf);
             json t{{"id", s.id}, {"file", rel}, {"channel", 0}};
-            if (set.gesture == "guettler") { t["accel_m_s2"] = s.accel; t["force_n"] = s.force; }
-            else if (set.gesture == "exp_speed") { t["v0_m_s"] = s.v0; t["tv_s"] = s.tv; t["force_n"] = s.force; }
+            if (set.gesture == "mixed") t["gesture"] = s.gesture;
+            if (s.gesture == "guettler") { t["accel_m_s2"] = s.accel; t["force_n"] = s.force; }
+            else if (s.gesture == "exp_speed") { t["v0_m_s"] = s.v0; t["tv_s"] = s.tv; t["force_n"] = s.force; }
             else { t["speed_m_s"] = s.speed; t["f0_n"] = s.f0; t["tf_s"] = s.tf; }
             if (s.trigger) t["trigger_s"] = *s.trigger;
             strokes.push_back(t);

@@ -212,7 +212,7 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     set.ambient = 20.0;
     set.units = spec.units;
     set.sampleRate = spec.outRate;
-    set.gesture = "guettler";
+    set.gesture = spec.gesture;
     // The lab's own steady-sliding measurement of this rosin, 1 % scatter.
     {
         std::normal_distribution<double> g(0.0, 1.0);
@@ -248,26 +248,51 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         std::mt19937_64 sr(spec.seed * 7919ull + static_cast<std::uint64_t>(k) + 11);
         std::uniform_real_distribution<double> uu(0.0, 1.0);
         const int ia = k % spec.grid, iF = k / spec.grid;
-        const double a = spec.aMin + (spec.aMax - spec.aMin) * ia / (spec.grid - 1);
+        const double x = static_cast<double>(ia) / (spec.grid - 1);
         const double F = spec.fMin + (spec.fMax - spec.fMin) * iF / (spec.grid - 1);
-        const double aTrue = a * (1.0 + spec.jitter * (2.0 * uu(sr) - 1.0));
-        const double fTrue = F * (1.0 + spec.jitter * (2.0 * uu(sr) - 1.0));
+        // The gesture the rig meant (in the manifest) and the one it made (jittered).
+        MeasuredStroke& m = set.strokes[static_cast<std::size_t>(k)];
+        static const char* kinds[3] = {"guettler", "exp_speed", "exp_force"};
+        m.gesture = spec.gesture == "mixed" ? kinds[(ia + iF) % 3] : spec.gesture; // every kind on every column and row
+        const double jitterDrive = 1.0 + spec.jitter * (2.0 * uu(sr) - 1.0);
+        const double jitterForce = 1.0 + spec.jitter * (2.0 * uu(sr) - 1.0);
+        char id[32];
+        if (m.gesture == "exp_speed") {
+            m.v0 = spec.expV0;
+            m.tv = spec.expV0 / (spec.aMin + (spec.aMax - spec.aMin) * x); // initial acceleration v0/tv on the grid
+            m.force = F;
+            std::snprintf(id, sizeof id, "v%02d_f%02d", ia, iF);
+        } else if (m.gesture == "exp_force") {
+            m.speed = spec.vMin + (spec.vMax - spec.vMin) * x;
+            m.f0 = F;
+            m.tf = spec.expTf;
+            std::snprintf(id, sizeof id, "c%02d_f%02d", ia, iF);
+        } else {
+            m.accel = spec.aMin + (spec.aMax - spec.aMin) * x;
+            m.force = F;
+            std::snprintf(id, sizeof id, "a%02d_f%02d", ia, iF);
+        }
+        m.id = id;
+        MeasuredStroke made = m;
+        made.accel *= jitterDrive;
+        made.v0 *= jitterDrive;
+        made.speed *= jitterDrive;
+        made.force *= jitterForce;
+        made.f0 *= jitterForce;
+        const Gesture g = strokeGesture(made, beta);
         reference::Simulator sim = prototype;
         std::vector<double> bridge(static_cast<std::size_t>(spec.seconds * simRate));
-        for (std::size_t i = 0; i < bridge.size(); ++i) bridge[i] = sim.step(fTrue, aTrue * static_cast<double>(i) / simRate).bridgeForce;
+        for (std::size_t i = 0; i < bridge.size(); ++i) {
+            const auto c = g.at(static_cast<double>(i) / simRate);
+            bridge[i] = sim.step(c.force, c.speed).bridgeForce;
+        }
         const double trigger = spec.triggerMax * uu(sr);
         const auto pre = static_cast<std::size_t>(trigger * spec.outRate);
-        MeasuredStroke& m = set.strokes[static_cast<std::size_t>(k)];
-        char id[32];
-        std::snprintf(id, sizeof id, "a%02d_f%02d", ia, iF);
-        m.id = id;
-        m.accel = a;
-        m.force = F;
         m.signal = record(std::move(bridge), pre, sr);
         {
             std::lock_guard<std::mutex> lock(truthLock);
             truth.triggers[m.id] = static_cast<double>(pre) / spec.outRate;
-            truth.strokes[m.id] = {aTrue, fTrue};
+            truth.strokes[m.id] = {gestureDrive(made), gestureForce(made)};
         }
         const int finished = ++done;
         if (progress && progressLock.try_lock()) {

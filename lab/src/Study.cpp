@@ -178,6 +178,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     json planJson = json::array();
     for (const auto& p : plan) planJson.push_back({{"index", p.index}, {"seed", p.seed}, {"effects", p.effects}});
     planJson = json{{"grid", o.grid}, {"seed", o.seed}, {"sets", planJson}};
+    if (o.gesture != "guettler") planJson["gesture"] = o.gesture; // Guettler studies' plans stay as they were
     // A folder resumes only the study it holds: sets are skipped by folder name, so a different
     // seed, size or grid would silently mix two studies.
     if (fs::exists(dir / "plan.json")) {
@@ -188,7 +189,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
         }
         if (before != planJson)
-            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls or grid); use a new folder");
+            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid or gesture); use a new folder");
     }
     fs::create_directories(dir / "sets");
     if (mpi.isRoot() && !fs::exists(dir / "plan.json")) std::ofstream(dir / "plan.json") << planJson.dump(1) << "\n";
@@ -212,11 +213,13 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         spec.effects = p.effects;
         spec.grid = o.grid;
         spec.oversampling = o.oversampling;
+        spec.gesture = o.gesture;
+        if (o.gesture == "exp_force") spec.units = "N";
         SynthTruth truth;
         say("simulating", 0.0);
         const MeasurementSet made = synthesize(spec, truth, [&](double x) { say("simulating", 0.5 * x); });
         writeTruth(here / "truth.json", truth, p.seed);
-        writeMeasurementSet(here / "set", made, SF_FORMAT_PCM_24);
+        writeMeasurementSet(here / "set", made, spec.units == "N" ? SF_FORMAT_FLOAT : SF_FORMAT_PCM_24); // newtons pass PCM's full scale
         const MeasurementSet set = readMeasurementSet(here / "set");
         DiagnoseOptions d = o.diagnose;
         d.quiet = true;

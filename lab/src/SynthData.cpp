@@ -62,7 +62,8 @@ void writeTruth(const std::filesystem::path& file, const SynthTruth& truth, std:
         t["rig"] = truth.rig;
         t["clipped_fraction"] = truth.clippedFraction;
         nlohmann::json strokes;
-        for (const auto& [id, af] : truth.strokes) strokes[id] = {{"accel_m_s2", af.first}, {"force_n", af.second}};
+        // drive as gestureDrive(): bow acceleration, v0/tv (exp_speed) or bow speed (exp_force)
+        for (const auto& [id, af] : truth.strokes) strokes[id] = {{"drive", af.first}, {"force_n", af.second}};
         t["strokes"] = strokes;
     }
     std::ofstream out(file);
@@ -75,6 +76,7 @@ MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::f
     if (spec.generator == "reference") return synthesizeReference(spec, truth, progress);
     if (spec.generator != "model") throw LabError("--generator must be model or reference");
     if (!spec.rig.empty()) throw LabError("--rig-param applies to --generator reference only");
+    if (spec.gesture != "guettler") throw LabError("--gesture applies to --generator reference only");
     if (spec.grid < 2 || spec.grid > 60) throw LabError("--grid must be within 2..60");
     if (!(spec.outRate >= 8000 && spec.outRate <= 384000)) throw LabError("--rate must be within 8000..384000 Hz");
     if (!(spec.simRate >= spec.outRate)) throw LabError("--sim-rate must not be below --rate");

@@ -216,6 +216,59 @@ TEST(MeasurementSet, BrokenSetsAreRefusedNamingFileAndField)
     fs::remove_all(d);
 }
 
+// A set may mix gestures (gesture.kind "mixed"): each transient names its own kind and that
+// kind's fields; they survive a write and a read, and a transient that names none is refused.
+TEST(MeasurementSet, MixedGesturesRoundTripAndAStrokeWithoutItsKindIsRefused)
+{
+    const fs::path d = freshDir("mixed");
+    SynthSpec spec = smallSpec(6);
+    spec.grid = 2;
+    SynthTruth truth;
+    MeasurementSet set = synthesize(spec, truth);
+    set.gesture = "mixed";
+    set.strokes[1].gesture = "exp_speed";
+    set.strokes[1].v0 = 0.12;
+    set.strokes[1].tv = 0.08;
+    set.strokes[2].gesture = "exp_force";
+    set.strokes[2].speed = 0.2;
+    set.strokes[2].f0 = 1.3;
+    set.strokes[2].tf = 0.015;
+    writeMeasurementSet(d / "set", set, SF_FORMAT_FLOAT);
+    const MeasurementSet back = readMeasurementSet(d / "set");
+    ASSERT_EQ(back.strokes.size(), set.strokes.size());
+    EXPECT_EQ(back.gesture, "mixed");
+    EXPECT_EQ(back.strokes[0].gesture, "guettler");
+    EXPECT_EQ(back.strokes[1].gesture, "exp_speed");
+    EXPECT_EQ(back.strokes[2].gesture, "exp_force");
+    EXPECT_DOUBLE_EQ(back.strokes[0].accel, set.strokes[0].accel);
+    EXPECT_DOUBLE_EQ(back.strokes[1].tv, 0.08);
+    EXPECT_DOUBLE_EQ(back.strokes[2].tf, 0.015);
+    // Each stroke's gesture drives the bow as its kind says.
+    EXPECT_NEAR(strokeGesture(back.strokes[1], 0.09).at(0.08).speed, 0.12 * (1.0 - std::exp(-1.0)), 1e-12);
+    EXPECT_NEAR(strokeGesture(back.strokes[2], 0.09).at(0.015).force, 1.3 * (1.0 - std::exp(-1.0)), 1e-12);
+    EXPECT_DOUBLE_EQ(strokeGesture(back.strokes[2], 0.09).at(0.0).speed, 0.2);
+    EXPECT_DOUBLE_EQ(gestureDrive(back.strokes[1]), 0.12 / 0.08);
+    EXPECT_DOUBLE_EQ(gestureForce(back.strokes[2]), 1.3);
+
+    auto edited = [&](const std::string& name, const std::string& from, const std::string& to) {
+        fs::copy(d / "set", d / name, fs::copy_options::recursive);
+        std::ifstream in(d / name / "manifest.json");
+        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const auto at = text.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        if (at != std::string::npos) text.replace(at, from.size(), to);
+        std::ofstream(d / name / "manifest.json") << text;
+        return errorOf(d / name);
+    };
+    std::string e = edited("no-kind", "\"gesture\": \"exp_speed\"", "\"gestur\": \"exp_speed\"");
+    EXPECT_NE(e.find("transients[1].gesture' is missing"), std::string::npos) << e;
+    e = edited("bad-kind", "\"gesture\": \"exp_force\"", "\"gesture\": \"exp_pressure\"");
+    EXPECT_NE(e.find("transients[2].gesture' must be"), std::string::npos) << e;
+    e = edited("bad-set-kind", "\"kind\": \"mixed\"", "\"kind\": \"several\"");
+    EXPECT_NE(e.find("gesture.kind' must be"), std::string::npos) << e;
+    fs::remove_all(d);
+}
+
 TEST(SynthDataCli, WritesASetAndItsTruthApartAndRefusesToOverwrite)
 {
     const fs::path d = freshDir("cli");

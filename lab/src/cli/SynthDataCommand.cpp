@@ -51,6 +51,8 @@ struct SynthDataCommand {
         synthCmd->add_option("--generator", synth.generator, "model or reference")->check(CLI::IsMember({"model", "reference"}))->capture_default_str();
         synthCmd->add_option("--rig-param", rigParams, "Reference rig value NAME=VALUE instead of a drawn one (see below)");
         synthCmd->add_option("--oversampling", synth.oversampling, "Reference: simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
+        synthCmd->add_option("--gesture", synth.gesture, "Reference: guettler, exp_speed (v0/tv x F), exp_force (speed x F0) or mixed")
+            ->check(CLI::IsMember({"guettler", "exp_speed", "exp_force", "mixed"}))->capture_default_str();
         synthCmd->add_option("-o,--out", synthOut, "New folder for the set (must not exist)")->capture_default_str();
         synthCmd->add_option("--effect", synth.effects, "Hidden effect; repeat for several")->check(CLI::IsMember(effectIds()));
         synthCmd->add_option("--param", synthParams, "Hidden parameter NAME=VALUE (r_A, h0, p, load_exponent, shift_k, zt_ratio)");

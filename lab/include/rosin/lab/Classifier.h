@@ -32,6 +32,11 @@ struct ClassifierInput {
     double z0 = 0;                   ///< transverse impedance (kg/s)
     double tension = 0, length = 0;  ///< string, for the quasi-static ramp (gain and trigger)
     std::function<double(double)> bowSpeed; ///< v_b(t) from the gesture start (m/s)
+    /// Recording mode, gestures that slide from the start (a rising force at constant speed):
+    /// the pre-slip bridge force is this shape of time from the gesture start times an unknown
+    /// factor, which carries the friction level and so is not the gain. Empty: the string
+    /// sticks to the bow and the pre-slip force is T x_b / (beta L) times the gain.
+    std::function<double(double)> rampShape;
     std::vector<std::uint8_t> stick; ///< simulation only: ground-truth stick flags
     /// Recording mode: remove DC and hum, low-pass, and estimate gain and trigger time from
     /// the pre-slip ramp. Off for simulations, where the signal is exact and in newtons.

@@ -16,6 +16,7 @@ struct DiagramOptions {
     bool bounds = true;   ///< Guettler's lossless-string bounds (PHYSICS.md 6.3)
     bool fit = true;      ///< fitted lower boundary F = c a^p
     double muS = 1.2, muD = 0.35; ///< friction coefficients for the bounds
+    std::string xLabel = "bow acceleration (m/s\u00b2)"; ///< the other gestures' maps have their own drive
 };
 
 

@@ -6,12 +6,16 @@
 #include <string>
 #include <vector>
 
+#include "rosin/lab/Gesture.h"
+
 namespace rosin::lab {
 
 struct MeasuredStroke {
     std::string id;
     std::filesystem::path file;
     int channel = 0;
+    /// guettler, exp_speed or exp_force: the set's kind, or the stroke's own in a mixed set.
+    std::string gesture = "guettler";
     // Gesture (by kind): guettler uses accel and force; exp_speed v0 and tv (and force);
     // exp_force speed, f0 and tf.
     double accel = 0, force = 0, v0 = 0, tv = 0, speed = 0, f0 = 0, tf = 0;
@@ -46,13 +50,21 @@ struct MeasurementSet {
     std::optional<double> ambient;     ///< C
     std::string units = "N";           ///< N (calibrated) or V (scale unknown)
     double sampleRate = 0;             ///< the manifest's rate: authoritative
-    std::string gesture = "guettler";  ///< guettler, exp_speed, exp_force
+    std::string gesture = "guettler";  ///< guettler, exp_speed, exp_force, or mixed (each stroke names its own)
     std::vector<MeasuredStroke> strokes;
     std::optional<std::filesystem::path> steadySliding;
     std::vector<SteadySlidingPoint> steady; ///< its rows (read from, or written to, steady_sliding.csv)
     std::vector<TwoEndedRecording> twoEnded;
     std::vector<std::string> warnings; ///< what the reader had to decide (said, not silently done)
 };
+
+/// The stroke's gesture as controls over time (t = 0 at the gesture start), at bow position beta.
+Gesture strokeGesture(const MeasuredStroke& s, double beta);
+/// The stroke's horizontal coordinate in its gesture's plane: bow acceleration (guettler),
+/// initial acceleration v0/tv (exp_speed), bow speed (exp_force).
+double gestureDrive(const MeasuredStroke& s);
+/// The stroke's bow force: F (guettler, exp_speed) or the final F0 (exp_force).
+double gestureForce(const MeasuredStroke& s);
 
 /// Reads and checks a set. Throws LabError naming the file and the field on any breach of
 /// the format; reads every signal so a broken file is found before anything is computed.

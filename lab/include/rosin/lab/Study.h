@@ -21,6 +21,9 @@ struct StudyOptions {
     int grid = 12;             ///< strokes per axis of each set
     std::uint64_t seed = 1;    ///< the plan, and each set's seed, follow from it
     int oversampling = 4;
+    /// The sets' strokes (synth-data --gesture): guettler, exp_speed, exp_force (then
+    /// calibrated in newtons: rising-force strokes alone cannot set a volt scale) or mixed.
+    std::string gesture = "guettler";
     bool keepSets = false;     ///< keep the generated WAV sets (regenerable from their seeds)
     DiagnoseOptions diagnose;
     bool quiet = false;

@@ -45,6 +45,12 @@ struct SynthSpec {
     std::string generator = "model";
     std::map<std::string, double> rig;    ///< reference: rig values fixed instead of drawn (referenceRigKeys())
     int oversampling = 4;                 ///< reference: simulation rate / file rate (>= 4)
+    /// reference: guettler (a x F grid), exp_speed (initial acceleration v0/tv x F, v0 fixed),
+    /// exp_force (bow speed x F0, tf fixed) or mixed (the three in turn over the grid).
+    std::string gesture = "guettler";
+    double expV0 = 0.1;                   ///< exp_speed: final bow speed (m/s)
+    double expTf = 0.02;                  ///< exp_force: force time constant (s)
+    double vMin = 0.05, vMax = 0.5;       ///< exp_force: bow speeds of the grid (m/s)
 };
 
 struct SynthTruth {
@@ -54,7 +60,7 @@ struct SynthTruth {
     std::map<std::string, double> triggers; ///< stroke id -> gesture start in its file (s)
     std::string generator = "model";
     std::map<std::string, double> rig;      ///< reference: every drawn rig value (referenceRigKeys())
-    std::map<std::string, std::pair<double, double>> strokes; ///< stroke id -> true (accel, force)
+    std::map<std::string, std::pair<double, double>> strokes; ///< stroke id -> true (drive, force): drive as gestureDrive()
     double clippedFraction = 0.0;           ///< share of samples at full scale
 };
 
