@@ -25,6 +25,7 @@ juce_add_plugin(RosinPlugin
 
 target_sources(RosinPlugin PRIVATE
   ${CMAKE_CURRENT_SOURCE_DIR}/src/RosinProcessor.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/src/RosinProcessorPresets.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/src/StateFormat.cpp
   ${PROJECT_SOURCE_DIR}/ui/RosinEditor.cpp
   ${PROJECT_SOURCE_DIR}/ui/LiveViews.cpp)
