@@ -345,9 +345,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     d.finalForce.resize(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
         d.ids[i] = strokes[i].id;
-        d.gestures[i] = strokes[i].kind;
-        d.drive[i] = strokes[i].drive;
-        d.force[i] = strokes[i].F;
+        d.gestures[i] = set.strokes[i].gesture;
+        d.drive[i] = strokes[i].gesture.drive();
+        d.force[i] = strokes[i].gesture.force;
         d.measured[i] = strokes[i].feat;
         d.baselineSim[i] = engine.simulate(d.baseline, i, &d.baselineForce[i]);
         d.finalSim[i] = engine.simulate(d.final, i, &d.finalForce[i]);

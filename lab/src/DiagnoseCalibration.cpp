@@ -106,12 +106,7 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     // knownGain 0: gain fitted per recording.
     auto recording = [&](std::size_t i, double knownGain) {
         const MeasuredStroke& s = set.strokes[i];
-        ClassifierInput in = guettlerStrokeInput(s.signal, set.sampleRate, info.f0, info.beta, info.z0, info.tension, info.length, 0.0);
-        const Gesture g = strokeGesture(s, info.beta);
-        in.bowSpeed = [g](double t) { return g.at(t).speed; };
-        // A rising force at full bow speed slides from the start: its pre-slip force follows
-        // the force's rise times a friction level, which says nothing of the sensor's scale.
-        if (s.gesture == "exp_force") in.rampShape = [g](double t) { return g.at(t).force; };
+        ClassifierInput in = strokeInput(s.signal, set.sampleRate, strokeGesture(s, info.beta), info);
         in.measured = true;
         in.knownGain = knownGain;
         return in;
@@ -179,9 +174,6 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
         Prepared& p = strokes[i];
         p.id = s.id;
         p.gesture = strokeGesture(s, info.beta);
-        p.kind = s.gesture;
-        p.drive = gestureDrive(s);
-        p.F = gestureForce(s);
         const auto from = static_cast<std::size_t>(std::max(0.0, cal[i].trigger) * set.sampleRate);
         std::vector<double> f;
         // Unfitted strokes are in signal units: the set's gain converts them.

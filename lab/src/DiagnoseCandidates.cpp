@@ -199,15 +199,15 @@ bool intervalAtNull(const std::string& name, double lo, double hi)
 
 std::vector<bool> upperDriveHalf(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes)
 {
-    std::map<std::string, std::vector<double>> drives;
-    for (auto i : from) drives[strokes[i].kind].push_back(strokes[i].drive);
-    std::map<std::string, double> mid;
+    std::map<GestureKind, std::vector<double>> drives;
+    for (auto i : from) drives[strokes[i].gesture.kind].push_back(strokes[i].gesture.drive());
+    std::map<GestureKind, double> mid;
     for (auto& [kind, d] : drives) {
         std::sort(d.begin(), d.end());
         mid[kind] = d[d.size() / 2];
     }
     std::vector<bool> upper;
-    for (auto i : from) upper.push_back(strokes[i].drive >= mid[strokes[i].kind]);
+    for (auto i : from) upper.push_back(strokes[i].gesture.drive() >= mid[strokes[i].gesture.kind]);
     return upper;
 }
 

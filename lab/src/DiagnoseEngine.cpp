@@ -12,6 +12,16 @@
 
 namespace rosin::lab::diag {
 
+ClassifierInput strokeInput(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s)
+{
+    ClassifierInput in = guettlerStrokeInput(std::move(f), fs, s.f0, s.beta, s.z0, s.tension, s.length, 0.0);
+    in.bowSpeed = [g](double t) { return g.at(t).speed; };
+    // A rising force at full bow speed slides from the start: its pre-slip force follows the
+    // force's rise times a friction level, which says nothing of a sensor's scale.
+    if (g.kind == GestureKind::ExpForce) in.rampShape = [g](double t) { return g.at(t).force; };
+    return in;
+}
+
 double noiseLevel(const std::vector<double>& f)
 {
     // Second differences: a ramp or a slow sawtooth leaves nothing, white noise of rms s leaves
@@ -26,8 +36,7 @@ double noiseLevel(const std::vector<double>& f)
 StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, bool recorded)
 {
     zeroPhaseLowPass(f, kCompareCutoff, fs);
-    ClassifierInput in = guettlerStrokeInput(f, fs, s.f0, s.beta, s.z0, s.tension, s.length, 0.0);
-    in.bowSpeed = [g](double t) { return g.at(t).speed; };
+    const ClassifierInput in = strokeInput(f, fs, g, s);
     const double F = g.force; // the final force of a rising-force stroke
     ClassifierSettings st;
     // A first slip drops the force by more than 2 % of the bow force, and in a recording by

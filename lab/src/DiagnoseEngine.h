@@ -28,8 +28,6 @@ struct StringInfo {
 struct Prepared {
     std::string id;
     Gesture gesture;           ///< as the manifest states it (t = 0 at the gesture start)
-    std::string kind;          ///< guettler, exp_speed or exp_force
-    double drive = 0, F = 0;   ///< the stroke's place in its gesture plane (gestureDrive(), gestureForce())
     std::vector<double> force; ///< N at the diagnosis rate, t = 0 at the gesture start
     double noise = 0;          ///< rms noise of the recording (N), added to its simulations
     StrokeFeatures feat;
@@ -37,6 +35,9 @@ struct Prepared {
 
 constexpr double kCompareCutoff = 5000.0; // both signals see the same low-pass before comparison
 
+/// Classifier input for a stroke of gesture g on string s: the bow speed follows the gesture, and
+/// a rising-force stroke (which slides from the start) gives the shape of its pre-slip force.
+ClassifierInput strokeInput(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s);
 /// Noise of a low-passed recording: the robust spread of its sample-to-sample steps.
 double noiseLevel(const std::vector<double>& f);
 StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, bool recorded = false);

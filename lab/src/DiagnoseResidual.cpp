@@ -53,8 +53,8 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
         std::vector<double> fs;
         bool guettlerOnly = true;
         for (auto i : testSet) {
-            fs.push_back(strokes[i].F);
-            guettlerOnly = guettlerOnly && strokes[i].kind == "guettler";
+            fs.push_back(strokes[i].gesture.force);
+            guettlerOnly = guettlerOnly && strokes[i].gesture.kind == GestureKind::Guettler;
         }
         const double fm = median(fs);
         double worst = -1;
@@ -63,7 +63,7 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
                 double sum = 0;
                 int cnt = 0;
                 for (std::size_t k = 0; k < testSet.size(); ++k)
-                    if (highDrive[k] == (qa == 1) && (strokes[testSet[k]].F >= fm) == (qf == 1)) {
+                    if (highDrive[k] == (qa == 1) && (strokes[testSet[k]].gesture.force >= fm) == (qf == 1)) {
                         sum += currentTest[k].total() - floorParts[k].total();
                         ++cnt;
                     }
@@ -80,9 +80,9 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
         for (auto i : testSet) {
             const StrokeFeatures& m = strokes[i].feat;
             // A rising-force stroke's bow speed is set, not reached: it says nothing here.
-            if (m.firstSlip <= 0 || strokes[i].kind == "exp_force") continue;
+            if (m.firstSlip <= 0 || strokes[i].gesture.kind == GestureKind::ExpForce) continue;
             logV.push_back(std::log(strokes[i].gesture.at(m.firstSlip).speed));
-            logF.push_back(std::log(strokes[i].F));
+            logF.push_back(std::log(strokes[i].gesture.force));
             ++cnt;
         }
         for (std::size_t k = 0; k < testSet.size(); ++k) {
@@ -90,7 +90,7 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
             const StrokeFeatures sim = engine.simulate(current, i);
             if (strokes[i].feat.firstSlip > 0 && sim.firstSlip > 0) {
                 slipBias += (sim.firstSlip - strokes[i].feat.firstSlip) / strokes[i].feat.firstSlip;
-                forceBias += (sim.forceBeforeSlip - strokes[i].feat.forceBeforeSlip) / strokes[i].F;
+                forceBias += (sim.forceBeforeSlip - strokes[i].feat.forceBeforeSlip) / strokes[i].gesture.force;
             }
         }
         slipBias /= std::max<std::size_t>(1, testSet.size());

@@ -29,6 +29,18 @@ Gesture::Controls Gesture::at(double t) const noexcept
     return {a.force + s * (b.force - a.force), a.speed + s * (b.speed - a.speed), a.beta + s * (b.beta - a.beta)};
 }
 
+double Gesture::drive() const noexcept
+{
+    switch (kind) {
+    case GestureKind::Guettler: return acceleration;
+    case GestureKind::ExpSpeed: return speed / timeConstant;
+    case GestureKind::Constant:
+    case GestureKind::ExpForce: return speed;
+    case GestureKind::File: break;
+    }
+    return 0.0;
+}
+
 GestureKind parseGestureKind(const std::string& name)
 {
     if (name == "guettler") return GestureKind::Guettler;

@@ -175,15 +175,6 @@ Gesture strokeGesture(const MeasuredStroke& s, double beta)
     return g;
 }
 
-double gestureDrive(const MeasuredStroke& s)
-{
-    if (s.gesture == "exp_speed") return s.v0 / s.tv;
-    if (s.gesture == "exp_force") return s.speed;
-    return s.accel;
-}
-
-double gestureForce(const MeasuredStroke& s) { return s.gesture == "exp_force" ? s.f0 : s.force; }
-
 MeasurementSet readMeasurementSet(const fs::path& folder)
 {
     const fs::path manifest = folder / "manifest.json";

@@ -292,7 +292,7 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         {
             std::lock_guard<std::mutex> lock(truthLock);
             truth.triggers[m.id] = static_cast<double>(pre) / spec.outRate;
-            truth.strokes[m.id] = {gestureDrive(made), gestureForce(made)};
+            truth.strokes[m.id] = {g.drive(), g.force};
         }
         const int finished = ++done;
         if (progress && progressLock.try_lock()) {

@@ -62,7 +62,7 @@ void writeTruth(const std::filesystem::path& file, const SynthTruth& truth, std:
         t["rig"] = truth.rig;
         t["clipped_fraction"] = truth.clippedFraction;
         nlohmann::json strokes;
-        // drive as gestureDrive(): bow acceleration, v0/tv (exp_speed) or bow speed (exp_force)
+        // drive as Gesture::drive(): bow acceleration, v0/tv (exp_speed) or bow speed (exp_force)
         for (const auto& [id, af] : truth.strokes) strokes[id] = {{"drive", af.first}, {"force_n", af.second}};
         t["strokes"] = strokes;
     }

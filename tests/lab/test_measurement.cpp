@@ -247,8 +247,8 @@ TEST(MeasurementSet, MixedGesturesRoundTripAndAStrokeWithoutItsKindIsRefused)
     EXPECT_NEAR(strokeGesture(back.strokes[1], 0.09).at(0.08).speed, 0.12 * (1.0 - std::exp(-1.0)), 1e-12);
     EXPECT_NEAR(strokeGesture(back.strokes[2], 0.09).at(0.015).force, 1.3 * (1.0 - std::exp(-1.0)), 1e-12);
     EXPECT_DOUBLE_EQ(strokeGesture(back.strokes[2], 0.09).at(0.0).speed, 0.2);
-    EXPECT_DOUBLE_EQ(gestureDrive(back.strokes[1]), 0.12 / 0.08);
-    EXPECT_DOUBLE_EQ(gestureForce(back.strokes[2]), 1.3);
+    EXPECT_DOUBLE_EQ(strokeGesture(back.strokes[1], 0.09).drive(), 0.12 / 0.08);
+    EXPECT_DOUBLE_EQ(strokeGesture(back.strokes[2], 0.09).force, 1.3);
 
     auto edited = [&](const std::string& name, const std::string& from, const std::string& to) {
         fs::copy(d / "set", d / name, fs::copy_options::recursive);

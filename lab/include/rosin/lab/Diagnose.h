@@ -126,7 +126,7 @@ struct Diagnosis {
     // For the report: features per stroke (measured, baseline, final), in set order.
     std::vector<std::string> ids;
     std::vector<std::string> gestures; ///< guettler, exp_speed or exp_force
-    std::vector<double> drive, force;  ///< place in the gesture's plane (gestureDrive(), gestureForce())
+    std::vector<double> drive, force;  ///< place in the gesture's plane (Gesture::drive(), the final bow force)
     std::vector<StrokeFeatures> measured, baselineSim, finalSim;
     std::vector<std::vector<double>> measuredForce, baselineForce, finalForce; ///< first 12 periods
 };

@@ -32,6 +32,10 @@ struct Gesture {
     };
     Controls at(double t) const noexcept;
 
+    /// The stroke's horizontal coordinate in its gesture's plane: bow acceleration (Guettler),
+    /// initial acceleration v0/tv (ExpSpeed), bow speed (ExpForce, Constant); 0 for a file.
+    double drive() const noexcept;
+
     /// Natural length: the last row's time for a file, otherwise 0 (caller chooses).
     double naturalDuration() const noexcept { return rows.empty() ? 0.0 : rows.back().time; }
 };

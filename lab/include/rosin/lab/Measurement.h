@@ -60,11 +60,6 @@ struct MeasurementSet {
 
 /// The stroke's gesture as controls over time (t = 0 at the gesture start), at bow position beta.
 Gesture strokeGesture(const MeasuredStroke& s, double beta);
-/// The stroke's horizontal coordinate in its gesture's plane: bow acceleration (guettler),
-/// initial acceleration v0/tv (exp_speed), bow speed (exp_force).
-double gestureDrive(const MeasuredStroke& s);
-/// The stroke's bow force: F (guettler, exp_speed) or the final F0 (exp_force).
-double gestureForce(const MeasuredStroke& s);
 
 /// Reads and checks a set. Throws LabError naming the file and the field on any breach of
 /// the format; reads every signal so a broken file is found before anything is computed.

@@ -60,7 +60,7 @@ struct SynthTruth {
     std::map<std::string, double> triggers; ///< stroke id -> gesture start in its file (s)
     std::string generator = "model";
     std::map<std::string, double> rig;      ///< reference: every drawn rig value (referenceRigKeys())
-    std::map<std::string, std::pair<double, double>> strokes; ///< stroke id -> true (drive, force): drive as gestureDrive()
+    std::map<std::string, std::pair<double, double>> strokes; ///< stroke id -> true (drive, force): drive as Gesture::drive()
     double clippedFraction = 0.0;           ///< share of samples at full scale
 };
 
