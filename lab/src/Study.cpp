@@ -71,6 +71,7 @@ struct Scored {
     std::vector<std::string> hidden, found;
     std::map<std::string, double> truth;
     std::map<std::string, std::array<double, 3>> estimate; ///< value, ci low, ci high
+    std::map<std::string, std::array<double, 3>> calibration; ///< nuisance -> value, ci low, ci high
     std::map<std::string, double> rig;
     double baseline = 0, final = 0;
     bool unexplained = false;
@@ -257,6 +258,10 @@ std::string scoreStudy(const fs::path& dir)
             for (const auto& [name, v] : finding["parameters"].items())
                 s.estimate[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
         }
+        if (d.contains("calibration") && d["calibration"].contains("values"))
+            for (const auto& [name, v] : d["calibration"]["values"].items())
+                if (v["value"].is_number() && v["ci95"].size() == 2)
+                    s.calibration[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
         s.baseline = d["gain"]["baseline"].get<double>();
         s.final = d["gain"]["final"].get<double>();
         s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
@@ -350,6 +355,27 @@ std::string scoreStudy(const fs::path& dir)
     md << fmt("\nCoverage of the 95 %% intervals over all named parameters: %.0f %%", intervals ? 100.0 * covered / intervals : 0.0)
        << " (" << covered << " of " << intervals << ").\n";
     summary["coverage"] = intervals ? static_cast<double>(covered) / intervals : 0.0;
+    // Nuisances: what the rig really was against what the diagnosis calibrated (not findings,
+    // so not in the coverage above, but their intervals should mean what they say too).
+    // Each nuisance is 1 + the rig's relative error of the same quantity.
+    const std::pair<const char*, const char*> nuisanceOfRig[]{{"tension_scale", "tension_error"}, {"beta_scale", "beta_error"}};
+    md << "\n| calibrated nuisance | sets | median error | worst error | truth inside the 95 % interval |\n|---|---|---|---|---|\n";
+    for (const auto& [name, rigError] : nuisanceOfRig) {
+        std::vector<double> err;
+        int inside = 0;
+        for (const auto& s : sets) {
+            if (!s.calibration.count(name) || !s.rig.count(rigError)) continue;
+            const double t = 1.0 + s.rig.at(rigError);
+            const auto& c = s.calibration.at(name);
+            err.push_back(std::abs(c[0] / t - 1.0));
+            inside += t >= c[1] && t <= c[2];
+        }
+        if (err.empty()) continue;
+        std::sort(err.begin(), err.end());
+        md << "| " << name << " | " << err.size() << " | " << fmt("%.1f %%", 100.0 * err[err.size() / 2]) << " | " << fmt("%.1f %%", 100.0 * err.back())
+           << " | " << inside << " of " << err.size() << " |\n";
+        summary["calibration"][name] = {{"sets", err.size()}, {"median_error", err[err.size() / 2]}, {"worst_error", err.back()}, {"covered", inside}};
+    }
     // Held-out error where nothing was hidden: what a good fit reaches on this rig population.
     std::vector<double> nullBase;
     for (const auto& s : sets)

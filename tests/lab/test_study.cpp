@@ -151,6 +151,35 @@ TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
     fs::remove_all(dir);
 }
 
+// The calibrated nuisances are scored against the rig that made the set: tension_scale against
+// 1 + tension_error, beta_scale against 1 + beta_error, with their intervals' coverage.
+TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
+{
+    const fs::path dir = freshDir("nuisances");
+    auto withCalibration = [](double tension, double tLow, double tHigh, double beta, double bLow, double bHigh) {
+        json d = diagnosis(json::array({{{"effect", "none"}}}));
+        d["calibration"]["values"]["tension_scale"] = {{"value", tension}, {"ci95", {tLow, tHigh}}};
+        d["calibration"]["values"]["beta_scale"] = {{"value", beta}, {"ci95", {bLow, bHigh}}};
+        return d;
+    };
+    const json rigA{{"tension_error", 0.02}, {"beta_error", -0.01}}, rigB{{"tension_error", -0.03}, {"beta_error", 0.02}};
+    // A: tension 1.01 for 1.02 (1 %, interval holds it); bow position 0.99 for 0.99 exactly.
+    writeSet(dir, 0, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigA}}, withCalibration(1.01, 1.0, 1.03, 0.99, 0.98, 1.0));
+    // B: tension 1.0 for 0.97 (3.1 %, interval misses it); bow position 1.0 for 1.02, missed too.
+    writeSet(dir, 1, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigB}}, withCalibration(1.0, 0.99, 1.01, 1.0, 0.99, 1.01));
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    const json& c = study["summary"]["calibration"];
+    EXPECT_EQ(c["tension_scale"]["sets"], 2);
+    EXPECT_EQ(c["tension_scale"]["covered"], 1);
+    EXPECT_NEAR(c["tension_scale"]["worst_error"].get<double>(), 1.0 / 0.97 - 1.0, 1e-9);
+    EXPECT_EQ(c["beta_scale"]["covered"], 1);
+    EXPECT_NEAR(c["beta_scale"]["worst_error"].get<double>(), 1.0 - 1.0 / 1.02, 1e-9);
+    EXPECT_NE(md.find("| tension_scale | 2 |"), std::string::npos) << md;
+    fs::remove_all(dir);
+}
+
 TEST(Study, ScoringAnEmptyFolderSaysSo)
 {
     const fs::path dir = freshDir("empty");
