@@ -207,8 +207,15 @@ TEST(Processor, FakePenPlaysAVoiceAndUnpluggingMidNoteLiftsTheBow)
     for (int tries = 0; tries < 400 && p.activeVoices() > 0; ++tries) blockRms(p, 1);
     EXPECT_EQ(p.activeVoices(), 0);
     EXPECT_NE(p.hidInput().status().find("unplugged"), std::string::npos) << p.hidInput().status();
-    blockRms(p, 10); // the body's own modes ring on for a few ms after the string is free
-    EXPECT_LT(blockRms(p, 10), 1e-6);
+    // The body's own modes ring on after the string is free, from wherever in its cycle the bow
+    // left (the HID thread's timing decides that, so the tail's level varies from run to run:
+    // usually under -120 dB at once, once still above it 20 blocks on under ThreadSanitizer).
+    // What must hold is that it dies away, to -120 dB within half a second.
+    int tailBlocks = 0;
+    double tail = 1.0;
+    while (tailBlocks < 94 && (tail = blockRms(p, 1)) >= 1e-6) ++tailBlocks;
+    EXPECT_LT(tailBlocks, 94) << "still " << tail << " after half a second";
+    EXPECT_LT(blockRms(p, 10), 1e-6); // and stays silent
 
     plugged = true; // and back
     for (int tries = 0; tries < 100 && p.hidInput().connections() < 2; ++tries) blockRms(p, 2);
