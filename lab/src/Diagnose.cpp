@@ -112,7 +112,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     const std::vector<ErrorParts> baselineTest = engine.errors(current, testSet);
     std::vector<ErrorParts> currentVal = engine.errors(current, valSet), currentTest = baselineTest;
     d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, tension within +-5 % and bow position within "
-               "+-4 % of the manifest, fitted on the fit strokes with the baseline model; effects are fitted on top of them.",
+               "+-4 % of the manifest, fitted on the fit strokes with the baseline model; effects are fitted on top of them. Once thermal memory "
+               "is tried, the bow side's thermal effusivity (0.65-1.35 x 450) is a nuisance too.",
                "An effect is fitted on the fit strokes and named only when (1) its validation-error fall is the largest of the round "
                "with a 95 % paired-bootstrap interval above 0, (2) the fall is at least " + std::to_string(static_cast<int>(std::lround(100 * o.namingThreshold))) +
                    " % of the validation error (threshold calibrated on null sets), and a candidate that brings thermal memory along "
@@ -313,8 +314,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 const auto kk = static_cast<Eigen::Index>(k);
                 const double v = x[kk], hw = 1.96 * std::sqrt(std::max(0.0, cov(kk, kk)));
                 if (isNuisance(names[k]))
-                    d.calibration.push_back({names[k], names[k] == "tension_scale" ? "true tension / manifest tension" : "true bow position / manifest beta", v,
-                                             v - hw, v + hw});
+                    d.calibration.push_back({names[k], nuisanceMeaning(names[k]), v, v - hw, v + hw});
                 for (auto& f : d.findings)
                     if (f.parameters.count(names[k])) f.curvature[names[k]] = {v - hw, v + hw};
             }

@@ -33,14 +33,25 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
         c.hi.push_back(hi);
         c.start.push_back(value);
     }
-    for (const char* k : {"tension_scale", "beta_scale"})
-        if (m.params.count(k)) {
-            c.names.push_back(k);
-            c.lo.push_back(parameterBounds().at(k).first);
-            c.hi.push_back(parameterBounds().at(k).second);
-            c.start.push_back(m.params.at(k));
-        }
+    const bool calibrated = m.params.count("tension_scale") > 0; // the diagnosis fits nuisances at all
+    const bool thermal = has(m.effects, "thermal_memory") || has(c.adds, "thermal_memory");
+    for (const char* k : {"tension_scale", "beta_scale", "rod_effusivity_scale"}) {
+        const bool rod = std::string(k) == "rod_effusivity_scale";
+        if (!m.params.count(k) && !(rod && calibrated && thermal)) continue;
+        c.names.push_back(k);
+        c.lo.push_back(parameterBounds().at(k).first);
+        c.hi.push_back(parameterBounds().at(k).second);
+        c.start.push_back(m.params.count(k) ? m.params.at(k) : 1.0);
+    }
     return c;
+}
+
+std::string nuisanceMeaning(const std::string& p)
+{
+    if (p == "tension_scale") return "true tension / manifest tension";
+    if (p == "beta_scale") return "true bow position / manifest beta";
+    if (p == "rod_effusivity_scale") return "bow-side thermal effusivity / 450 W s^1/2 m^-2 K^-1";
+    return p;
 }
 
 /// A candidate whose parameters take their bounds from parameterBounds().
@@ -82,7 +93,9 @@ const std::map<std::string, std::pair<double, double>>& parameterBounds()
     static const std::map<std::string, std::pair<double, double>> b{{"r_A", {0.5, 2.0}},          {"h0", {0.3, 1.2}},
                                                                       {"p", {0.1, 0.8}},            {"load_exponent", {0.4, 1.1}},
                                                                       {"shift_k", {-30.0, 30.0}},   {"zt_ratio", {0.7, 8.0}},
-                                                                      {"tension_scale", {0.95, 1.05}}, {"beta_scale", {0.96, 1.04}}};
+                                                                      {"tension_scale", {0.95, 1.05}}, {"beta_scale", {0.96, 1.04}},
+                                                                      // bow hair and rosin: 300-600 W s^1/2 m^-2 K^-1 (W03 Table I gives 450)
+                                                                      {"rod_effusivity_scale", {0.65, 1.35}}};
     return b;
 }
 

@@ -97,6 +97,7 @@ dsp::BowedStringConfig Engine::config(const EffectModel& m) const
     c.string.length = info_.length;
     c.string.tension = info_.tension * get("tension_scale");
     c.string.massPerLength = c.string.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
+    c.friction.thermal.rodEffusivity *= get("rod_effusivity_scale");
     return c;
 }
 

@@ -357,15 +357,22 @@ std::string scoreStudy(const fs::path& dir)
     summary["coverage"] = intervals ? static_cast<double>(covered) / intervals : 0.0;
     // Nuisances: what the rig really was against what the diagnosis calibrated (not findings,
     // so not in the coverage above, but their intervals should mean what they say too).
-    // Each nuisance is 1 + the rig's relative error of the same quantity.
-    const std::pair<const char*, const char*> nuisanceOfRig[]{{"tension_scale", "tension_error"}, {"beta_scale", "beta_error"}};
+    // Tension and bow position are 1 + the rig's relative error of the same quantity; the rod's
+    // effusivity is the rig's value over the model's nominal 450.
+    struct RigSide {
+        const char* nuisance;
+        const char* rigKey;
+        double offset, divisor;
+    };
+    const RigSide nuisanceOfRig[]{{"tension_scale", "tension_error", 1.0, 1.0}, {"beta_scale", "beta_error", 1.0, 1.0},
+                                  {"rod_effusivity_scale", "rod_effusivity", 0.0, 450.0}};
     md << "\n| calibrated nuisance | sets | median error | worst error | truth inside the 95 % interval |\n|---|---|---|---|---|\n";
-    for (const auto& [name, rigError] : nuisanceOfRig) {
+    for (const auto& [name, rigKey, offset, divisor] : nuisanceOfRig) {
         std::vector<double> err;
         int inside = 0;
         for (const auto& s : sets) {
-            if (!s.calibration.count(name) || !s.rig.count(rigError)) continue;
-            const double t = 1.0 + s.rig.at(rigError);
+            if (!s.calibration.count(name) || !s.rig.count(rigKey)) continue;
+            const double t = offset + s.rig.at(rigKey) / divisor;
             const auto& c = s.calibration.at(name);
             err.push_back(std::abs(c[0] / t - 1.0));
             inside += t >= c[1] && t <= c[2];
@@ -388,7 +395,7 @@ std::string scoreStudy(const fs::path& dir)
     std::ofstream csv(dir / "study.csv");
     csv << "set,seed,hidden,found,exact,baseline_error,final_error,unexplained";
     for (const auto& p : parameterNames()) csv << "," << p << "_true," << p << "_found," << p << "_ci_low," << p << "_ci_high";
-    const std::vector<std::string> rigCols{"noise_n", "inharmonicity", "bridge_z0y", "headroom", "tension_error", "beta_error", "mu_level"};
+    const std::vector<std::string> rigCols{"noise_n", "inharmonicity", "bridge_z0y", "headroom", "tension_error", "beta_error", "mu_level", "rod_effusivity"};
     for (const auto& r : rigCols) csv << "," << r;
     csv << "\n";
     json perSet = json::array();

@@ -97,12 +97,29 @@ TEST(DiagnoseReference, NamesNothingOnANullRig)
     // Calibration, not findings: the rig's static friction from its steady_sliding.csv, within
     // 3 % (its prior spans +-7 %).
     double mu = 0;
-    for (const auto& c : o.d.calibration)
+    for (const auto& c : o.d.calibration) {
         if (c.name == "mu_static") mu = c.value;
+        EXPECT_NE(c.name, "rod_effusivity_scale") << "the rod's heat matters only to a thermal model";
+    }
     EXPECT_NEAR(mu / (1.2 * o.truth.rig.at("mu_level") * (0.85 + 0.35 * o.truth.rig.at("mu_floor_scale")) / 1.2), 1.0, 0.03);
 }
 
-TEST(DiagnoseReference, FindsThermalMemoryAndItsFootprint) { expectDiagnosis(run({"thermal_memory"}, {{"r_A", 0.8}}, 42)); }
+// The bow side's thermal effusivity is calibration once the model is thermal: reported with its
+// meaning and an interval inside its literature range (300-600 for the model's 450), never a finding.
+TEST(DiagnoseReference, FindsThermalMemoryAndItsFootprint)
+{
+    const Outcome o = run({"thermal_memory"}, {{"r_A", 0.8}}, 42);
+    expectDiagnosis(o);
+    int rods = 0;
+    for (const auto& c : o.d.calibration)
+        if (c.name == "rod_effusivity_scale") {
+            ++rods;
+            EXPECT_NE(c.meaning.find("effusivity"), std::string::npos);
+            EXPECT_TRUE(c.low <= c.value && c.value <= c.high) << c.low << " " << c.value << " " << c.high;
+            EXPECT_TRUE(c.value >= 0.65 && c.value <= 1.35) << c.value;
+        }
+    EXPECT_EQ(rods, 1);
+}
 
 TEST(DiagnoseReference, FindsAHertzianContact) { expectDiagnosis(run({"hertzian_contact"}, {{"load_exponent", 0.65}}, 43)); }
 

@@ -152,7 +152,8 @@ TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
 }
 
 // The calibrated nuisances are scored against the rig that made the set: tension_scale against
-// 1 + tension_error, beta_scale against 1 + beta_error, with their intervals' coverage.
+// 1 + tension_error, beta_scale against 1 + beta_error, rod_effusivity_scale against the rig's
+// rod effusivity over 450 (only sets with a thermal model calibrate it), with their intervals' coverage.
 TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
 {
     const fs::path dir = freshDir("nuisances");
@@ -162,9 +163,12 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
         d["calibration"]["values"]["beta_scale"] = {{"value", beta}, {"ci95", {bLow, bHigh}}};
         return d;
     };
-    const json rigA{{"tension_error", 0.02}, {"beta_error", -0.01}}, rigB{{"tension_error", -0.03}, {"beta_error", 0.02}};
+    const json rigA{{"tension_error", 0.02}, {"beta_error", -0.01}, {"rod_effusivity", 540.0}},
+        rigB{{"tension_error", -0.03}, {"beta_error", 0.02}, {"rod_effusivity", 360.0}};
+    json thermalA = withCalibration(1.01, 1.0, 1.03, 0.99, 0.98, 1.0);
+    thermalA["calibration"]["values"]["rod_effusivity_scale"] = {{"value", 1.1}, {"ci95", {1.0, 1.15}}}; // for 1.2: 8.3 % low, missed
     // A: tension 1.01 for 1.02 (1 %, interval holds it); bow position 0.99 for 0.99 exactly.
-    writeSet(dir, 0, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigA}}, withCalibration(1.01, 1.0, 1.03, 0.99, 0.98, 1.0));
+    writeSet(dir, 0, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigA}}, thermalA);
     // B: tension 1.0 for 0.97 (3.1 %, interval misses it); bow position 1.0 for 1.02, missed too.
     writeSet(dir, 1, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigB}}, withCalibration(1.0, 0.99, 1.01, 1.0, 0.99, 1.01));
     const std::string md = scoreStudy(dir);
@@ -176,6 +180,9 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
     EXPECT_NEAR(c["tension_scale"]["worst_error"].get<double>(), 1.0 / 0.97 - 1.0, 1e-9);
     EXPECT_EQ(c["beta_scale"]["covered"], 1);
     EXPECT_NEAR(c["beta_scale"]["worst_error"].get<double>(), 1.0 - 1.0 / 1.02, 1e-9);
+    EXPECT_EQ(c["rod_effusivity_scale"]["sets"], 1);
+    EXPECT_EQ(c["rod_effusivity_scale"]["covered"], 0);
+    EXPECT_NEAR(c["rod_effusivity_scale"]["worst_error"].get<double>(), 1.0 - 1.1 / 1.2, 1e-9);
     EXPECT_NE(md.find("| tension_scale | 2 |"), std::string::npos) << md;
     fs::remove_all(dir);
 }

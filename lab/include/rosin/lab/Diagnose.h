@@ -57,7 +57,7 @@ struct DiagnoseOptions {
     /// sets of `rosin study` so that at most 5 % of them name anything (docs/diagnosis.md).
     double namingThreshold = 0.05;
     double residualFactor = 3.0;    ///< final error above this many times the floor: unexplained residual
-    bool fitNuisances = true;       ///< tension and bow position within their priors, as calibration
+    bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     bool quiet = false;
 };
 
