@@ -210,7 +210,6 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             // Rules (4) and (5) judge the candidate's own parameters; those of earlier findings and
             // the nuisances were free in the refits but were judged when they entered.
             for (std::size_t k = 0; k < t.c.scanned; ++k) {
-                if (isNuisance(t.c.names[k])) continue; // scanned beside thermal memory, judged as calibration
                 double m = 0, v = 0;
                 for (const auto& r : refits) m += r[k];
                 m /= static_cast<double>(refits.size());
@@ -227,7 +226,6 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 halves.push_back(diag::fit(engine, current, t.c, subset(fitSet, strokes, high), t.x, std::max(8, o.maxEvaluations / 2), 0.1, nullptr, false));
             std::map<std::string, double> lowFit, highFit;
             for (std::size_t k = 0; k < t.c.scanned; ++k) {
-                if (isNuisance(t.c.names[k])) continue;
                 lowFit[t.c.names[k]] = halves[0][k];
                 highFit[t.c.names[k]] = halves[1][k];
                 const double spread = std::abs(halves[0][k] - halves[1][k]);

@@ -24,18 +24,6 @@ bool has(const std::vector<std::string>& v, const std::string& x) { return std::
 /// hide the contact (sets with both came out with r_A 15-30 % low and no contact named).
 Candidate withNuisances(Candidate c, const EffectModel& m)
 {
-    const bool calibrated = m.params.count("tension_scale") > 0; // the diagnosis fits nuisances at all
-    // Thermal memory alone is what a rate dependence or a rosin shift must beat (rule 2), so it
-    // gets the bow side's effusivity on its grid: started at nominal, COBYLA left it within a
-    // few percent of 1 whatever the rig (0.98-1.0 on most sets of the seed-2029 study), and sets
-    // with a cool-running rod named a rosin shift instead (-16 K for a rod at 0.69 x nominal).
-    const bool scanRod = calibrated && c.effect == "thermal_memory" && !m.params.count("rod_effusivity_scale");
-    if (scanRod) {
-        c.names.push_back("rod_effusivity_scale");
-        c.lo.push_back(parameterBounds().at("rod_effusivity_scale").first);
-        c.hi.push_back(parameterBounds().at("rod_effusivity_scale").second);
-        c.start.push_back(1.0);
-    }
     c.scanned = c.names.size();
     for (const auto& [name, value] : m.params) {
         if (isNuisance(name) || std::find(c.names.begin(), c.names.end(), name) != c.names.end()) continue;
@@ -45,10 +33,10 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
         c.hi.push_back(hi);
         c.start.push_back(value);
     }
+    const bool calibrated = m.params.count("tension_scale") > 0; // the diagnosis fits nuisances at all
     const bool thermal = has(m.effects, "thermal_memory") || has(c.adds, "thermal_memory");
     for (const char* k : {"tension_scale", "beta_scale", "rod_effusivity_scale"}) {
         const bool rod = std::string(k) == "rod_effusivity_scale";
-        if (rod && scanRod) continue;
         if (!m.params.count(k) && !(rod && calibrated && thermal)) continue;
         c.names.push_back(k);
         c.lo.push_back(parameterBounds().at(k).first);
