@@ -35,22 +35,37 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
     }
     const bool calibrated = m.params.count("tension_scale") > 0; // the diagnosis fits nuisances at all
     const bool thermal = has(m.effects, "thermal_memory") || has(c.adds, "thermal_memory");
-    for (const char* k : {"tension_scale", "beta_scale", "rod_effusivity_scale"}) {
-        const bool rod = std::string(k) == "rod_effusivity_scale";
-        if (!m.params.count(k) && !(rod && calibrated && thermal)) continue;
-        c.names.push_back(k);
-        c.lo.push_back(parameterBounds().at(k).first);
-        c.hi.push_back(parameterBounds().at(k).second);
-        c.start.push_back(m.params.count(k) ? m.params.at(k) : 1.0);
+    for (const Nuisance& k : nuisances()) {
+        if (!m.params.count(k.name) && !(k.thermalOnly && calibrated && thermal)) continue;
+        c.names.push_back(k.name);
+        c.lo.push_back(parameterBounds().at(k.name).first);
+        c.hi.push_back(parameterBounds().at(k.name).second);
+        c.start.push_back(m.params.count(k.name) ? m.params.at(k.name) : 1.0);
     }
     return c;
 }
 
+const std::vector<Nuisance>& nuisances()
+{
+    // The rod's effusivity (how fast the bow hair draws heat from the contact) is a scale of the
+    // model's own nominal value, so its meaning names that value.
+    static const std::vector<Nuisance> list{
+        {"tension_scale", "true tension / manifest tension"},
+        {"beta_scale", "true bow position / manifest beta"},
+        {"rod_effusivity_scale",
+         "bow-side thermal effusivity / " + std::to_string(std::lround(dsp::ThermalParams{}.rodEffusivity)) + " W s^1/2 m^-2 K^-1", true}};
+    return list;
+}
+
+bool isNuisance(const std::string& p)
+{
+    return std::any_of(nuisances().begin(), nuisances().end(), [&](const Nuisance& k) { return k.name == p; });
+}
+
 std::string nuisanceMeaning(const std::string& p)
 {
-    if (p == "tension_scale") return "true tension / manifest tension";
-    if (p == "beta_scale") return "true bow position / manifest beta";
-    if (p == "rod_effusivity_scale") return "bow-side thermal effusivity / 450 W s^1/2 m^-2 K^-1";
+    for (const Nuisance& k : nuisances())
+        if (k.name == p) return k.meaning;
     return p;
 }
 

@@ -61,10 +61,15 @@ std::string describe(const std::string& effect, const std::vector<ErrorParts>& b
 /// what was taken out goes into d.calibration, what had to be assumed into d.warnings.
 std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo& info, const DiagnoseOptions& o, Diagnosis& d);
 
-/// What a lab never knows exactly and diagnosis fits as calibration, not as a finding. The rod's
-/// effusivity (how fast the bow hair draws heat from the contact) only matters to a thermal
-/// model, so it is free only once thermal memory is in the model or the candidate.
-inline bool isNuisance(const std::string& p) { return p == "tension_scale" || p == "beta_scale" || p == "rod_effusivity_scale"; }
+/// What a lab never knows exactly and diagnosis fits as calibration, not as a finding.
+struct Nuisance {
+    std::string name;
+    std::string meaning;     ///< what its value is, in the report's words
+    bool thermalOnly = false; ///< matters only to a thermal model: free once thermal memory is in the model or the candidate
+};
+/// Every nuisance, in the order the fits append them.
+const std::vector<Nuisance>& nuisances();
+bool isNuisance(const std::string& p);
 /// What a nuisance's value means, in the report's words.
 std::string nuisanceMeaning(const std::string& p);
 

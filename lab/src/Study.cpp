@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "rosin/dsp/FrictionLaws.h"
 #include "rosin/lab/Distributed.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
@@ -358,14 +359,14 @@ std::string scoreStudy(const fs::path& dir)
     // Nuisances: what the rig really was against what the diagnosis calibrated (not findings,
     // so not in the coverage above, but their intervals should mean what they say too).
     // Tension and bow position are 1 + the rig's relative error of the same quantity; the rod's
-    // effusivity is the rig's value over the model's nominal 450.
+    // effusivity is the rig's value over the model's nominal, which the diagnosis scales.
     struct RigSide {
         const char* nuisance;
         const char* rigKey;
         double offset, divisor;
     };
     const RigSide nuisanceOfRig[]{{"tension_scale", "tension_error", 1.0, 1.0}, {"beta_scale", "beta_error", 1.0, 1.0},
-                                  {"rod_effusivity_scale", "rod_effusivity", 0.0, 450.0}};
+                                  {"rod_effusivity_scale", "rod_effusivity", 0.0, dsp::ThermalParams{}.rodEffusivity}};
     md << "\n| calibrated nuisance | sets | median error | worst error | truth inside the 95 % interval |\n|---|---|---|---|---|\n";
     for (const auto& [name, rigKey, offset, divisor] : nuisanceOfRig) {
         std::vector<double> err;
