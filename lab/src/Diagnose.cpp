@@ -164,6 +164,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         std::sort(tried.begin(), tried.end(), [](const Tried& a, const Tried& b) { return a.gain[0] > b.gain[0]; });
         const Tried* best = nullptr;
         std::map<std::string, double> halfWidth;
+        std::map<std::string, std::vector<double>> halvesOf;
         for (const Tried& t : tried) {
             Trial& trial = d.trials[t.trial];
             if (!(t.gain[1] > 0.0) || trial.relativeGain < o.namingThreshold) continue;
@@ -236,6 +237,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 continue;
             }
             trial.verdict = "named";
+            for (const auto& [name, v] : lowFit) halvesOf[name] = {v, highFit.at(name)};
             best = &t;
             break;
         }
@@ -271,6 +273,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             for (auto& [name, v] : f.parameters) {
                 const double moved = current.params.at(name) - v[0];
                 for (double& x2 : v) x2 += moved;
+                if (f.halves.count(name))
+                    for (double& x2 : f.halves[name]) x2 += moved;
             }
         currentTest = engine.errors(current, testSet);
         for (const auto& effect : best->c.adds) {
@@ -281,6 +285,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 if (effectOfParameter(name) == effect) {
                     const double v = current.params[name];
                     finding.parameters[name] = {v, v - halfWidth[name], v + halfWidth[name]};
+                    // the halves were fitted around the candidate's value; the joint refit moved it
+                    const auto k = static_cast<std::size_t>(std::find(best->c.names.begin(), best->c.names.end(), name) - best->c.names.begin());
+                    if (halvesOf.count(name)) finding.halves[name] = {halvesOf[name][0] + v - best->x[k], halvesOf[name][1] + v - best->x[k]};
                 }
             finding.heldoutBefore = before;
             finding.heldoutAfter = mean(currentVal);

@@ -72,8 +72,15 @@ struct Finding {
     std::string evidence;
     std::map<std::string, std::vector<double>> parameters; ///< name -> {value, ci low, ci high} (bootstrap refits)
     std::map<std::string, std::vector<double>> curvature;  ///< name -> {ci low, ci high} (Gauss-Newton)
+    /// name -> {low-drive half, high-drive half}: the parameter refitted on each half of the fit
+    /// strokes (rule 5), moved with the parameter when later rounds refit it
+    std::map<std::string, std::vector<double>> halves;
     double heldoutBefore = 0, heldoutAfter = 0;            ///< validation error before and after
 };
+
+/// The 95 % interval a finding reports for one of its parameters: the bootstrap refits' interval
+/// widened to the curvature's and to the refits on the two drive halves.
+std::pair<double, double> reportedInterval(const Finding& f, const std::string& name);
 
 /// One candidate extension tried in one round: fitted on the fit strokes, judged on validation.
 struct Trial {
