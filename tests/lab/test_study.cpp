@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "rosin/lab/Diagnose.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Study.h"
 
@@ -184,6 +185,46 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
     EXPECT_EQ(c["rod_effusivity_scale"]["covered"], 0);
     EXPECT_NEAR(c["rod_effusivity_scale"]["worst_error"].get<double>(), 1.0 - 1.1 / 1.2, 1e-9);
     EXPECT_NE(md.find("| tension_scale | 2 |"), std::string::npos) << md;
+    fs::remove_all(dir);
+}
+
+// A finding's reported interval spans its bootstrap refits, its curvature interval and its refits
+// on the two drive halves; an estimate given without the last two is the bootstrap's alone.
+TEST(Study, TheReportedIntervalSpansBootstrapCurvatureAndDriveHalves)
+{
+    Finding f;
+    f.parameters["r_A"] = {1.0, 0.97, 1.03};
+    EXPECT_EQ(reportedInterval(f, "r_A"), std::make_pair(0.97, 1.03));
+    f.curvature["r_A"] = {0.95, 1.02};
+    EXPECT_EQ(reportedInterval(f, "r_A"), std::make_pair(0.95, 1.03));
+    f.halves["r_A"] = {1.08, 0.99}; // the high-drive half above both
+    EXPECT_EQ(reportedInterval(f, "r_A"), std::make_pair(0.95, 1.08));
+}
+
+// The study counts coverage with the reported intervals and, beside it, with the bootstrap and
+// curvature intervals alone (what was reported before the drive halves widened it).
+TEST(Study, CountsCoverageWithAndWithoutTheDriveHalves)
+{
+    const fs::path dir = freshDir("halves");
+    auto thermal = [](double value, double low, double high, double bLow, double bHigh, double cLow, double cHigh) {
+        json f = finding("thermal_memory", "r_A", value, low, high);
+        f["parameters"]["r_A"]["ci95_bootstrap"] = {bLow, bHigh};
+        f["parameters"]["r_A"]["ci95_curvature"] = {cLow, cHigh};
+        return diagnosis(json::array({f}));
+    };
+    const json truth{{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.1}}}};
+    // Covered only thanks to the halves (bootstrap and curvature stop at 1.05).
+    writeSet(dir, 0, truth, thermal(1.0, 0.95, 1.12, 0.97, 1.03, 0.95, 1.05));
+    // Covered by the curvature interval already.
+    writeSet(dir, 1, truth, thermal(1.05, 1.0, 1.15, 1.02, 1.08, 1.0, 1.15));
+    // Missed by all.
+    writeSet(dir, 2, truth, thermal(0.9, 0.85, 0.95, 0.87, 0.93, 0.85, 0.95));
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    EXPECT_NEAR(study["summary"]["coverage"].get<double>(), 2.0 / 3.0, 1e-12);
+    EXPECT_NEAR(study["summary"]["coverage_without_halves"].get<double>(), 1.0 / 3.0, 1e-12);
+    EXPECT_NE(md.find("without the drive halves"), std::string::npos) << md;
     fs::remove_all(dir);
 }
 
