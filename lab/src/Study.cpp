@@ -90,7 +90,7 @@ std::string joined(const std::vector<std::string>& v)
 
 std::string fmt(const char* f, double x)
 {
-    char b[64];
+    char b[256];
     std::snprintf(b, sizeof b, f, x);
     return b;
 }
