@@ -164,7 +164,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         std::sort(tried.begin(), tried.end(), [](const Tried& a, const Tried& b) { return a.gain[0] > b.gain[0]; });
         const Tried* best = nullptr;
         std::map<std::string, double> halfWidth;
-        std::map<std::string, std::vector<double>> halvesOf;
+        std::map<std::string, std::array<double, 2>> halvesOffset; // the named candidate's halves, from its value
         for (const Tried& t : tried) {
             Trial& trial = d.trials[t.trial];
             if (!(t.gain[1] > 0.0) || trial.relativeGain < o.namingThreshold) continue;
@@ -237,7 +237,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 continue;
             }
             trial.verdict = "named";
-            for (const auto& [name, v] : lowFit) halvesOf[name] = {v, highFit.at(name)};
+            for (std::size_t k = 0; k < t.c.scanned; ++k) halvesOffset[t.c.names[k]] = {halves[0][k] - t.x[k], halves[1][k] - t.x[k]};
             best = &t;
             break;
         }
@@ -285,9 +285,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 if (effectOfParameter(name) == effect) {
                     const double v = current.params[name];
                     finding.parameters[name] = {v, v - halfWidth[name], v + halfWidth[name]};
-                    // the halves were fitted around the candidate's value; the joint refit moved it
-                    const auto k = static_cast<std::size_t>(std::find(best->c.names.begin(), best->c.names.end(), name) - best->c.names.begin());
-                    if (halvesOf.count(name)) finding.halves[name] = {halvesOf[name][0] + v - best->x[k], halvesOf[name][1] + v - best->x[k]};
+                    // the halves keep their offsets from the value, which the joint refit moved
+                    if (const auto h = halvesOffset.find(name); h != halvesOffset.end()) finding.halves[name] = {v + h->second[0], v + h->second[1]};
                 }
             finding.heldoutBefore = before;
             finding.heldoutAfter = mean(currentVal);

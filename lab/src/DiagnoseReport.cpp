@@ -127,7 +127,6 @@ std::string fmt(double x, const char* f = "%.3g")
     return b;
 }
 
-
 } // namespace
 
 namespace diag {
