@@ -96,7 +96,11 @@ std::vector<Candidate> candidates(const EffectModel& m)
     };
     if (!thermal) out.push_back(candidate("thermal_memory", {"r_A"}, {1.0}));
     if (!has(m.effects, "rate_dependence")) out.push_back(withRA(candidate("rate_dependence", {"h0", "p"}, {0.563, 0.4})));
-    if (!has(m.effects, "hertzian_contact")) out.push_back(candidate("hertzian_contact", {"load_exponent"}, {0.8}));
+    // Once thermal memory is named, r_A has taken up part of a contact's footprint: the contact's
+    // grid spans r_A too, or the search starts where r_A stands in for it and stays there.
+    if (!has(m.effects, "hertzian_contact"))
+        out.push_back(thermal && m.params.count("r_A") ? candidate("hertzian_contact", {"load_exponent", "r_A"}, {0.8, m.params.at("r_A")})
+                                                       : candidate("hertzian_contact", {"load_exponent"}, {0.8}));
     if (!has(m.effects, "rosin_temperature_shift")) out.push_back(withRA(candidate("rosin_temperature_shift", {"shift_k"}, {0.0})));
     if (!has(m.effects, "torsional_compliance")) out.push_back(candidate("torsional_compliance", {"zt_ratio"}, {2.0}));
     return out;

@@ -70,7 +70,11 @@ void expectDiagnosis(const Outcome& o)
     std::sort(found.begin(), found.end());
     std::sort(want.begin(), want.end());
     std::string tried;
-    for (const auto& t : o.d.trials) tried += " [" + std::to_string(t.round) + " " + t.effect + ": " + t.verdict + "]";
+    for (const auto& t : o.d.trials) {
+        tried += "\n  [" + std::to_string(t.round) + " " + t.effect + " fall " + std::to_string(t.relativeGain) + " over thermal " + std::to_string(t.overThermal);
+        for (const auto& [name, value] : t.parameters) tried += " " + name + "=" + std::to_string(value);
+        tried += ": " + t.verdict + "]";
+    }
     EXPECT_EQ(found, want) << "tried:" << tried;
     for (const auto& f : o.d.findings)
         for (const auto& [name, v] : f.parameters) {
@@ -122,6 +126,18 @@ TEST(DiagnoseReference, FindsThermalMemoryAndItsFootprint)
 }
 
 TEST(DiagnoseReference, FindsAHertzianContact) { expectDiagnosis(run({"hertzian_contact"}, {{"load_exponent", 0.65}}, 43)); }
+
+// A contact on a thermal rig: thermal memory without the contact reaches for a rosin shift
+// (on a 12x12 set of this kind, +30 K, the end of its range, was named first and stayed beside
+// the contact named next, 0.75 for 0.6). A parameter pinned at its range's end is not named,
+// the contact's search spans r_A once thermal memory is named, and an earlier finding that a
+// later one makes redundant is dropped: thermal memory and the contact, nothing else, each
+// within tolerance. (On an 8x8 set of this kind a 7 K shift is still named beside the
+// contact: without it the validation error is 14 % higher. See docs/diagnosis-study.md.)
+TEST(DiagnoseReferenceLong, FindsAContactOnAThermalRigAndNoStandInShift)
+{
+    expectDiagnosis(run({"thermal_memory", "hertzian_contact"}, {{"r_A", 0.92}, {"load_exponent", 0.6}}, 8101, 12));
+}
 
 // Other gestures (MEASUREMENT_FORMAT: exp_speed, exp_force, and sets that mix them). A mixed
 // set in volts takes its scale from the pre-slip ramps of its guettler and exp_speed strokes
