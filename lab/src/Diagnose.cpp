@@ -302,6 +302,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         // contact not yet tried): each earlier finding must still earn its place, by the naming
         // threshold on validation, against the model refitted without it. The weakest goes first,
         // and a dropped effect is not tried again.
+        EffectModel earlier = from; // the model before this round, less what has been dropped since
         while (true) {
             struct Without {
                 std::string effect;
@@ -311,7 +312,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             };
             std::optional<Without> weakest;
             std::vector<Without> tested;
-            for (const auto& effect : from.effects) {
+            for (const auto& effect : earlier.effects) {
                 if (!has(current.effects, effect)) continue;
                 // rate dependence and a rosin shift exist only in the thermal model
                 if (effect == "thermal_memory" && (has(current.effects, "rate_dependence") || has(current.effects, "rosin_temperature_shift"))) continue;
@@ -320,7 +321,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 // again, grid and all, on the model that never named the earlier effect (a joint
                 // refit from where the earlier effect left the other parameters stays there).
                 Without w{effect, {}, {}, 0.0};
-                const EffectModel before = removed(from, effect);
+                const EffectModel before = removed(earlier, effect);
                 const std::vector<Candidate> again = candidates(before);
                 const auto winner = std::find_if(again.begin(), again.end(), [&](const Candidate& c) { return c.effect == best->c.effect; });
                 if (winner != again.end()) {
@@ -354,6 +355,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == weakest->effect; }),
                              d.findings.end());
             dropped.insert(weakest->effect);
+            earlier = removed(earlier, weakest->effect);
             current = weakest->model;
             currentVal = weakest->val;
         }
