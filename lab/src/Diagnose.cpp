@@ -48,12 +48,16 @@ std::string effectOfParameter(const std::string& parameter)
 using namespace diag;
 
 namespace {
-/// The model without one effect and its parameters (thermal memory takes the rod's heat with it).
+/// The model without one effect and its parameters (thermal memory takes the nuisances that
+/// matter only to a thermal model with it).
 EffectModel removed(EffectModel m, const std::string& effect)
 {
+    auto thermalOnly = [](const std::string& name) {
+        return std::any_of(nuisances().begin(), nuisances().end(), [&](const Nuisance& k) { return k.thermalOnly && k.name == name; });
+    };
     m.effects.erase(std::remove(m.effects.begin(), m.effects.end(), effect), m.effects.end());
     for (auto it = m.params.begin(); it != m.params.end();) {
-        const bool its = effectOfParameter(it->first) == effect || (effect == "thermal_memory" && it->first == "rod_effusivity_scale");
+        const bool its = effectOfParameter(it->first) == effect || (effect == "thermal_memory" && thermalOnly(it->first));
         it = its ? m.params.erase(it) : std::next(it);
     }
     return m;
@@ -277,21 +281,18 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         currentVal = best->val;
         // A parameter fitted before a later effect entered may have stood in for it: refit all
         // parameters, nuisances included, and keep the refit unless it does worse on validation.
-        auto refitJoint = [&](const EffectModel& m) {
-            if (m.params.size() < 2) return m;
+        if (current.params.size() > 1) {
+            say("round " + std::to_string(round) + ": joint refit", 0.0);
             Candidate all;
             all.effect = "joint";
-            for (const auto& [name, value] : m.params) {
+            for (const auto& [name, value] : current.params) {
                 all.names.push_back(name);
                 all.lo.push_back(parameterBounds().at(name).first);
                 all.hi.push_back(parameterBounds().at(name).second);
                 all.start.push_back(value);
             }
-            return apply(m, all, diag::fit(engine, m, all, fitSet, all.start, o.maxEvaluations, 0.05, nullptr, false));
-        };
-        if (current.params.size() > 1) {
-            say("round " + std::to_string(round) + ": joint refit", 0.0);
-            const EffectModel refit = refitJoint(current);
+            const auto x = diag::fit(engine, current, all, fitSet, all.start, o.maxEvaluations, 0.05, nullptr, false);
+            const EffectModel refit = apply(current, all, x);
             const auto refitVal = engine.errors(refit, valSet);
             if (mean(refitVal) <= mean(currentVal)) {
                 current = refit;
@@ -310,7 +311,6 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 std::vector<ErrorParts> val;
                 double share = 0;
             };
-            std::optional<Without> weakest;
             std::vector<Without> tested;
             for (const auto& effect : earlier.effects) {
                 if (!has(current.effects, effect)) continue;
@@ -319,23 +319,20 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 say("round " + std::to_string(round) + ": without " + effect, 0.0);
                 // Searched as hard as the model it is compared with: this round's winner is fitted
                 // again, grid and all, on the model that never named the earlier effect (a joint
-                // refit from where the earlier effect left the other parameters stays there).
-                Without w{effect, {}, {}, 0.0};
+                // refit from where the earlier effect left the other parameters stays there). The
+                // winner is new this round, so the model without the earlier effect offers it.
                 const EffectModel before = removed(earlier, effect);
                 const std::vector<Candidate> again = candidates(before);
                 const auto winner = std::find_if(again.begin(), again.end(), [&](const Candidate& c) { return c.effect == best->c.effect; });
-                if (winner != again.end()) {
-                    const Candidate c = withNuisances(*winner, before);
-                    w.model = apply(before, c, diag::fit(engine, before, c, fitSet, c.start, o.maxEvaluations, 0.2));
-                } else {
-                    w.model = refitJoint(removed(current, effect));
-                }
+                if (winner == again.end()) continue;
+                const Candidate c = withNuisances(*winner, before);
+                Without w{effect, apply(before, c, diag::fit(engine, before, c, fitSet, c.start, o.maxEvaluations, 0.2)), {}, 0.0};
                 w.val = engine.errors(w.model, valSet);
                 const double e = mean(w.val);
                 w.share = e > 0 ? (e - mean(currentVal)) / e : 0.0;
-                if (w.share < o.namingThreshold && (!weakest || w.share < weakest->share)) weakest = w;
                 tested.push_back(std::move(w));
             }
+            const auto weakest = std::min_element(tested.begin(), tested.end(), [](const Without& a, const Without& b) { return a.share < b.share; });
             auto record = [&](const Without& w, const std::string& verdict) {
                 Trial t;
                 t.round = round;
@@ -347,7 +344,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 t.verdict = verdict;
                 d.trials.push_back(t);
             };
-            if (!weakest) {
+            if (weakest == tested.end() || weakest->share >= o.namingThreshold) {
                 for (const Without& w : tested) record(w, "kept beside " + best->c.effect + ": without it the validation error rises by the share shown");
                 break;
             }
