@@ -208,7 +208,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             // threshold, or one extra parameter's small gain would name it beside thermal memory.
             // (Only the size: significance of the increment on a quarter of an 8x8 set is too much
             // to ask of a real 14 K shift, and the candidate's whole fall was significant already.)
-            if (t.c.adds.size() > 1) {
+            if (needsThermal(t.c.effect) && has(t.c.adds, "thermal_memory")) {
                 const auto alone = std::find_if(tried.begin(), tried.end(), [](const Tried& u) { return u.c.effect == "thermal_memory"; });
                 if (alone != tried.end()) {
                     const double base = mean(alone->val);
@@ -314,8 +314,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             std::vector<Without> tested;
             for (const auto& effect : earlier.effects) {
                 if (!has(current.effects, effect)) continue;
-                // rate dependence and a rosin shift exist only in the thermal model
-                if (effect == "thermal_memory" && (has(current.effects, "rate_dependence") || has(current.effects, "rosin_temperature_shift"))) continue;
+                if (effect == "thermal_memory" && std::any_of(current.effects.begin(), current.effects.end(), needsThermal)) continue;
                 say("round " + std::to_string(round) + ": without " + effect, 0.0);
                 // Searched as hard as the model it is compared with: this round's winner is fitted
                 // again, grid and all, on the model that never named the earlier effect (a joint

@@ -80,12 +80,17 @@ Candidate candidate(const std::string& effect, std::vector<std::string> names, s
     return c;
 }
 
+bool needsThermal(const std::string& effect)
+{
+    return effect == "rate_dependence" || effect == "rosin_temperature_shift";
+}
+
 std::vector<Candidate> candidates(const EffectModel& m)
 {
     std::vector<Candidate> out;
     const bool thermal = has(m.effects, "thermal_memory");
-    auto withRA = [&](Candidate c) {
-        if (!thermal) {
+    auto withThermal = [&](Candidate c) {
+        if (!thermal && needsThermal(c.effect)) {
             c.adds.insert(c.adds.begin(), "thermal_memory");
             c.names.insert(c.names.begin(), "r_A");
             c.lo.insert(c.lo.begin(), parameterBounds().at("r_A").first);
@@ -95,13 +100,13 @@ std::vector<Candidate> candidates(const EffectModel& m)
         return c;
     };
     if (!thermal) out.push_back(candidate("thermal_memory", {"r_A"}, {1.0}));
-    if (!has(m.effects, "rate_dependence")) out.push_back(withRA(candidate("rate_dependence", {"h0", "p"}, {0.563, 0.4})));
+    if (!has(m.effects, "rate_dependence")) out.push_back(withThermal(candidate("rate_dependence", {"h0", "p"}, {0.563, 0.4})));
     // Once thermal memory is named, r_A has taken up part of a contact's footprint: the contact's
     // grid spans r_A too, or the search starts where r_A stands in for it and stays there.
     if (!has(m.effects, "hertzian_contact"))
         out.push_back(thermal && m.params.count("r_A") ? candidate("hertzian_contact", {"load_exponent", "r_A"}, {0.8, m.params.at("r_A")})
                                                        : candidate("hertzian_contact", {"load_exponent"}, {0.8}));
-    if (!has(m.effects, "rosin_temperature_shift")) out.push_back(withRA(candidate("rosin_temperature_shift", {"shift_k"}, {0.0})));
+    if (!has(m.effects, "rosin_temperature_shift")) out.push_back(withThermal(candidate("rosin_temperature_shift", {"shift_k"}, {0.0})));
     if (!has(m.effects, "torsional_compliance")) out.push_back(candidate("torsional_compliance", {"zt_ratio"}, {2.0}));
     return out;
 }

@@ -89,7 +89,11 @@ const std::map<std::string, std::pair<double, double>>& parameterBounds();
 Candidate candidate(const std::string& effect, std::vector<std::string> names, std::vector<double> start);
 /// The candidate with the model's nuisances, and the parameters of effects already named, free too.
 Candidate withNuisances(Candidate c, const EffectModel& m);
-/// The extensions not yet in m (rate dependence and the rosin shift bring thermal memory along).
+/// True for an effect that exists only inside the thermal model (rate dependence, the rosin
+/// shift): offered without thermal memory it brings it along, and thermal memory cannot be
+/// taken out from under it.
+bool needsThermal(const std::string& effect);
+/// The extensions not yet in m (those that need thermal memory bring it along).
 std::vector<Candidate> candidates(const EffectModel& m);
 /// True when the fitted parameters put the effect at its own absence.
 bool atNull(const std::string& effect, const std::map<std::string, double>& p);
