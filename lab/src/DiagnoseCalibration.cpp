@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include <tbb/parallel_for.h>
 
@@ -137,13 +138,29 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     d.triggersDetected = !allGains.empty() || shapesFitted;
     if (unfitted > 0)
         d.warnings.push_back(std::to_string(unfitted) + " stroke(s) slipped before a pre-slip ramp could be fitted: their gesture start is taken as the file start");
-    double gain = median(gains.size() >= 3 ? gains : allGains);
-    if (!(gain > 0)) gain = 1.0;
+    const std::vector<double>& used = gains.size() >= 3 ? gains : allGains;
+    double gain = median(used);
+    // The median's own spread, from resampled strokes.
+    double gainLow = gain, gainHigh = gain;
+    if (used.size() >= 3) {
+        std::mt19937_64 rng(o.seed * 7919ull + 11ull);
+        std::uniform_int_distribution<std::size_t> pick(0, used.size() - 1);
+        std::vector<double> medians;
+        for (int b = 0; b < 400; ++b) {
+            std::vector<double> r(used.size());
+            for (auto& x : r) x = used[pick(rng)];
+            medians.push_back(median(std::move(r)));
+        }
+        std::sort(medians.begin(), medians.end());
+        gainLow = medians[10];
+        gainHigh = medians[389];
+    }
+    if (!(gain > 0)) gain = gainLow = gainHigh = 1.0;
     if (set.units == "N") {
         if (std::abs(gain - 1.0) > 0.2)
             d.warnings.push_back("calibrated in N, but the pre-slip ramps suggest a scale of " + std::to_string(gain) +
                                  " units per N: the string data may be off");
-        gain = 1.0;
+        gain = gainLow = gainHigh = 1.0;
     }
     d.scale = 1.0 / gain;
     // Mains hum: taken out of every recording only when most recordings show it.
@@ -187,7 +204,21 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     });
 
 
-    d.calibration.push_back({"scale_n_per_unit", "sensor scale (N per signal unit) from the pre-slip ramps", d.scale, d.scale, d.scale});
+    // A ramp measures the scale times the string's static stiffness T / (beta (1 - beta) L), and the
+    // manifest's tension and bow position are known only within the priors the fits give them:
+    // the interval carries that stiffness's range as well as the median's spread.
+    if (set.units == "V") {
+        const auto& tension = parameterBounds().at("tension_scale");
+        const auto& position = parameterBounds().at("beta_scale");
+        auto stiffness = [&](double t, double b) { return t * (1.0 - info.beta) / (b * (1.0 - b * info.beta)); };
+        const double softest = stiffness(tension.first, position.second), stiffest = stiffness(tension.second, position.first);
+        d.calibration.push_back({"scale_n_per_unit",
+                                 "sensor scale (N per signal unit) from the pre-slip ramps; the interval spans the median's spread and the "
+                                 "manifest tension and bow position within their priors",
+                                 d.scale, softest / gainHigh, stiffest / gainLow});
+    } else {
+        d.calibration.push_back({"scale_n_per_unit", "sensor scale: the set is calibrated in N", 1.0, 1.0, 1.0});
+    }
     {
         std::vector<double> dcs;
         for (const auto& c : cal) dcs.push_back(c.dc * d.scale);

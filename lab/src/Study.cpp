@@ -254,6 +254,9 @@ std::string scoreStudy(const fs::path& dir)
         s.hidden = t["effects"].get<std::vector<std::string>>();
         s.truth = t["params"].get<std::map<std::string, double>>();
         if (t.contains("rig")) s.rig = t["rig"].get<std::map<std::string, double>>();
+        // The sensor's true scale is the inverse of the gain the generator applied.
+        if (t.contains("gain_units_per_N") && t["gain_units_per_N"].get<double>() > 0.0)
+            s.rig["scale_n_per_unit"] = 1.0 / t["gain_units_per_N"].get<double>();
         for (const auto& finding : d["findings"]) {
             const std::string e = finding["effect"].get<std::string>();
             if (e == "none") continue;
@@ -379,8 +382,10 @@ std::string scoreStudy(const fs::path& dir)
         const char* rigKey;
         double offset, divisor;
     };
-    const RigSide nuisanceOfRig[]{{"tension_scale", "tension_error", 1.0, 1.0}, {"beta_scale", "beta_error", 1.0, 1.0},
-                                  {"rod_effusivity_scale", "rod_effusivity", 0.0, dsp::ThermalParams{}.rodEffusivity}};
+    const RigSide nuisanceOfRig[]{{"tension_scale", "tension_error", 1.0, 1.0},
+                                  {"beta_scale", "beta_error", 1.0, 1.0},
+                                  {"rod_effusivity_scale", "rod_effusivity", 0.0, dsp::ThermalParams{}.rodEffusivity},
+                                  {"scale_n_per_unit", "scale_n_per_unit", 0.0, 1.0}};
     md << "\n| calibrated nuisance | sets | median error | worst error | truth inside the 95 % interval |\n|---|---|---|---|---|\n";
     for (const auto& [name, rigKey, offset, divisor] : nuisanceOfRig) {
         std::vector<double> err;

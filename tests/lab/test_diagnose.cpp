@@ -77,8 +77,14 @@ void check(const Case& k)
     } else {
         EXPECT_EQ(d.finalError, d.baselineError);
     }
-    // The unknown gain of a volt-calibrated set comes back from the physics.
+    // The unknown gain of a volt-calibrated set comes back from the physics, the report gives it
+    // once, and its interval (the ramps' spread and the priors of tension and bow position) holds it.
     EXPECT_NEAR(d.scale * truth.gain, 1.0, 0.05);
+    const auto scale = std::find_if(d.calibration.begin(), d.calibration.end(), [](const CalibrationValue& c) { return c.name == "scale_n_per_unit"; });
+    ASSERT_NE(scale, d.calibration.end());
+    EXPECT_EQ(scale->value, d.scale);
+    EXPECT_LE(scale->low, 1.0 / truth.gain);
+    EXPECT_GE(scale->high, 1.0 / truth.gain);
 }
 } // namespace
 

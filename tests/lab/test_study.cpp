@@ -154,7 +154,8 @@ TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
 
 // The calibrated nuisances are scored against the rig that made the set: tension_scale against
 // 1 + tension_error, beta_scale against 1 + beta_error, rod_effusivity_scale against the rig's
-// rod effusivity over 450 (only sets with a thermal model calibrate it), with their intervals' coverage.
+// rod effusivity over 450 (only sets with a thermal model calibrate it), the sensor scale against
+// the inverse of the generator's gain, with their intervals' coverage.
 TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
 {
     const fs::path dir = freshDir("nuisances");
@@ -168,10 +169,15 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
         rigB{{"tension_error", -0.03}, {"beta_error", 0.02}, {"rod_effusivity", 360.0}};
     json thermalA = withCalibration(1.01, 1.0, 1.03, 0.99, 0.98, 1.0);
     thermalA["calibration"]["values"]["rod_effusivity_scale"] = {{"value", 1.1}, {"ci95", {1.0, 1.15}}}; // for 1.2: 8.3 % low, missed
+    // The sensor: 4.1 N per unit for a gain of 0.25 units per N (2.5 % high, interval holds it).
+    thermalA["calibration"]["values"]["scale_n_per_unit"] = {{"value", 4.1}, {"ci95", {3.8, 4.3}}};
     // A: tension 1.01 for 1.02 (1 %, interval holds it); bow position 0.99 for 0.99 exactly.
-    writeSet(dir, 0, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigA}}, thermalA);
-    // B: tension 1.0 for 0.97 (3.1 %, interval misses it); bow position 1.0 for 1.02, missed too.
-    writeSet(dir, 1, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigB}}, withCalibration(1.0, 0.99, 1.01, 1.0, 0.99, 1.01));
+    writeSet(dir, 0, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigA}, {"gain_units_per_N", 0.25}}, thermalA);
+    // B: tension 1.0 for 0.97 (3.1 %, interval misses it); bow position 1.0 for 1.02, missed too;
+    // the sensor 2.1 N per unit for 2 (5 % high, missed).
+    json setB = withCalibration(1.0, 0.99, 1.01, 1.0, 0.99, 1.01);
+    setB["calibration"]["values"]["scale_n_per_unit"] = {{"value", 2.1}, {"ci95", {2.05, 2.2}}};
+    writeSet(dir, 1, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigB}, {"gain_units_per_N", 0.5}}, setB);
     const std::string md = scoreStudy(dir);
     json study;
     std::ifstream(dir / "study.json") >> study;
@@ -184,6 +190,10 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
     EXPECT_EQ(c["rod_effusivity_scale"]["sets"], 1);
     EXPECT_EQ(c["rod_effusivity_scale"]["covered"], 0);
     EXPECT_NEAR(c["rod_effusivity_scale"]["worst_error"].get<double>(), 1.0 - 1.1 / 1.2, 1e-9);
+    EXPECT_EQ(c["scale_n_per_unit"]["sets"], 2);
+    EXPECT_EQ(c["scale_n_per_unit"]["covered"], 1);
+    EXPECT_NEAR(c["scale_n_per_unit"]["worst_error"].get<double>(), 0.05, 1e-9);
+    EXPECT_NEAR(c["scale_n_per_unit"]["median_error"].get<double>(), 0.05, 1e-9); // the upper of two
     EXPECT_NE(md.find("| tension_scale | 2 |"), std::string::npos) << md;
     fs::remove_all(dir);
 }
