@@ -26,16 +26,10 @@ bool isSuccess(Regime r) { return r == Regime::Helmholtz || r == Regime::SMotion
 
 namespace {
 
-/// Solves the small normal-equation system A^T A c = A^T y by Gaussian elimination.
-std::vector<double> leastSquares(const std::vector<std::vector<double>>& cols, const std::vector<double>& y)
+/// Solves the augmented normal equations [A^T A | A^T y] (m rows, m + 1 columns) by Gaussian elimination.
+std::vector<double> solveNormal(std::vector<std::vector<double>> a)
 {
-    const std::size_t m = cols.size();
-    std::vector<std::vector<double>> a(m, std::vector<double>(m + 1, 0.0));
-    for (std::size_t i = 0; i < m; ++i) {
-        for (std::size_t j = 0; j < m; ++j)
-            for (std::size_t n = 0; n < y.size(); ++n) a[i][j] += cols[i][n] * cols[j][n];
-        for (std::size_t n = 0; n < y.size(); ++n) a[i][m] += cols[i][n] * y[n];
-    }
+    const std::size_t m = a.size();
     for (std::size_t i = 0; i < m; ++i) {
         std::size_t pivot = i;
         for (std::size_t r = i + 1; r < m; ++r)
@@ -51,6 +45,38 @@ std::vector<double> leastSquares(const std::vector<std::vector<double>>& cols, c
     std::vector<double> c(m, 0.0);
     for (std::size_t i = 0; i < m; ++i) c[i] = std::abs(a[i][i]) < 1e-300 ? 0.0 : a[i][m] / a[i][i];
     return c;
+}
+
+double dot(const std::vector<double>& x, const std::vector<double>& y, std::size_t n)
+{
+    double s = 0.0;
+    for (std::size_t k = 0; k < n; ++k) s += x[k] * y[k];
+    return s;
+}
+
+/// Least squares of y on the columns cols, where the products among the columns that do not
+/// change from call to call (all but `varying`, which may be cols.size() for none) are given
+/// in `fixed` (m x m, entries touching `varying` ignored): the trigger search refits the same
+/// DC and hum columns against a ramp that moves with each trial start.
+std::vector<double> leastSquares(const std::vector<std::vector<double>>& cols, const std::vector<double>& y,
+                                 const std::vector<std::vector<double>>& fixed, std::size_t varying)
+{
+    const std::size_t m = cols.size();
+    std::vector<std::vector<double>> a(m, std::vector<double>(m + 1, 0.0));
+    for (std::size_t i = 0; i < m; ++i) {
+        for (std::size_t j = 0; j < m; ++j) a[i][j] = (i == varying || j == varying) ? dot(cols[i], cols[j], y.size()) : fixed[i][j];
+        a[i][m] = dot(cols[i], y, y.size());
+    }
+    return solveNormal(std::move(a));
+}
+
+/// The products of every pair of columns over the first n samples.
+std::vector<std::vector<double>> gram(const std::vector<std::vector<double>>& cols, std::size_t n)
+{
+    std::vector<std::vector<double>> g(cols.size(), std::vector<double>(cols.size(), 0.0));
+    for (std::size_t i = 0; i < cols.size(); ++i)
+        for (std::size_t j = 0; j < cols.size(); ++j) g[i][j] = dot(cols[i], cols[j], n);
+    return g;
 }
 
 /// First sample where the signal falls by more than 5 % of its level (above `base`) within
@@ -124,8 +150,24 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
     // them out of the whole record writes a false 50 Hz wave into it.
     std::erase_if(hums, [&](double hum) { return hum > 0.0 && end < fs / hum; });
     if (hums.empty()) hums = {0.0};
+    std::vector<double> bestCoefficients;
+    int bestHarmonics = 0;
     for (double hum : hums) {
         const int harmonics = hum > 0.0 ? 4 : 0;
+        // Column 1 is the ramp, which moves with the trial start; the DC and the hum's sines
+        // do not, nor do their products with each other.
+        std::vector<std::vector<double>> cols(2 + 2 * harmonics, std::vector<double>(static_cast<std::size_t>(end)));
+        for (int i = 0; i < end; ++i) {
+            cols[0][i] = 1.0;
+            for (int h = 1; h <= harmonics; ++h) {
+                cols[2 * h][i] = std::sin(2 * std::numbers::pi * hum * h * i / fs);
+                cols[2 * h + 1][i] = std::cos(2 * std::numbers::pi * hum * h * i / fs);
+            }
+        }
+        const std::vector<std::vector<double>> fixedAll = gram(cols, static_cast<std::size_t>(end));
+        std::vector<std::vector<double>> fixedRest = fixedAll; // without the ramp's row and column
+        fixedRest.erase(fixedRest.begin() + 1);
+        for (auto& row : fixedRest) row.erase(row.begin() + 1);
         // Trigger search: coarse grid over the pre-slip time, then refined around the best.
         double lo = 0.0, hi = end / fs, bestT0 = 0.0;
         for (int pass = 0; pass < 3; ++pass) {
@@ -134,15 +176,8 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
             for (int s = 0; s <= steps; ++s) {
                 const double t0 = lo + (hi - lo) * s / steps;
                 const auto xb = bowDisplacement(in.bowSpeed, fs, end, t0);
-                std::vector<std::vector<double>> cols(2 + 2 * harmonics, std::vector<double>(static_cast<std::size_t>(end)));
-                for (int i = 0; i < end; ++i) {
-                    cols[0][i] = 1.0;
+                for (int i = 0; i < end; ++i)
                     cols[1][i] = in.rampShape ? (i / fs > t0 ? in.rampShape(i / fs - t0) : 0.0) : stiffness * xb[i];
-                    for (int h = 1; h <= harmonics; ++h) {
-                        cols[2 * h][i] = std::sin(2 * std::numbers::pi * hum * h * i / fs);
-                        cols[2 * h + 1][i] = std::cos(2 * std::numbers::pi * hum * h * i / fs);
-                    }
-                }
                 std::vector<double> y(f.begin(), f.begin() + end);
                 std::vector<double> c;
                 if (in.knownGain > 0.0 && !in.rampShape) {
@@ -150,11 +185,11 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
                     for (int i = 0; i < end; ++i) y[i] -= in.knownGain * cols[1][i];
                     std::vector<std::vector<double>> rest(cols);
                     rest.erase(rest.begin() + 1);
-                    c = leastSquares(rest, y);
+                    c = leastSquares(rest, y, fixedRest, rest.size());
                     c.insert(c.begin() + 1, in.knownGain);
                     for (int i = 0; i < end; ++i) y[i] += in.knownGain * cols[1][i];
                 } else {
-                    c = leastSquares(cols, y);
+                    c = leastSquares(cols, y, fixedAll, 1);
                 }
                 double r = 0.0;
                 for (int i = 0; i < end; ++i) {
@@ -171,11 +206,8 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
                     best.dc = c[0];
                     best.trigger = t0;
                     best.hum = hum;
-                    best.humWave.assign(static_cast<std::size_t>(n), 0.0);
-                    for (int i = 0; i < n; ++i)
-                        for (int h = 1; h <= harmonics; ++h)
-                            best.humWave[i] += c[2 * h] * std::sin(2 * std::numbers::pi * hum * h * i / fs)
-                                               + c[2 * h + 1] * std::cos(2 * std::numbers::pi * hum * h * i / fs);
+                    bestCoefficients = c;
+                    bestHarmonics = harmonics;
                 }
             }
             bestT0 = passT0;
@@ -183,6 +215,14 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
             lo = std::max(0.0, bestT0 - span);
             hi = bestT0 + span;
         }
+    }
+    // The hum over the whole record, once, from the best fit's coefficients.
+    if (!bestCoefficients.empty()) {
+        best.humWave.assign(static_cast<std::size_t>(n), 0.0);
+        for (int i = 0; i < n; ++i)
+            for (int h = 1; h <= bestHarmonics; ++h)
+                best.humWave[i] += bestCoefficients[2 * h] * std::sin(2 * std::numbers::pi * best.hum * h * i / fs)
+                                   + bestCoefficients[2 * h + 1] * std::cos(2 * std::numbers::pi * best.hum * h * i / fs);
     }
     // The sensor's offset is what it reads while the string rests before the gesture. Where the
     // recording holds a millisecond of that rest, the offset comes from it, and the ramp's gain is

@@ -106,6 +106,25 @@ double Engine::beta(const EffectModel& m) const
     return info_.beta * (m.params.count("beta_scale") ? m.params.at("beta_scale") : 1.0);
 }
 
+namespace {
+std::vector<double> strokeNoise(std::size_t stroke, std::size_t length, double level, std::uint64_t seed)
+{
+    std::vector<double> x(length);
+    std::mt19937_64 rng(0x9e3779b97f4a7c15ull * (stroke + 1) + seed);
+    std::normal_distribution<double> g(0.0, level);
+    for (double& v : x) v = g(rng);
+    return x;
+}
+} // namespace
+
+Engine::Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady)
+    : strokes_(strokes), info_(info), fs_(fs), steady_(steady), noise_(strokes.size())
+{
+    tbb::parallel_for(std::size_t(0), strokes.size(), [&](std::size_t i) {
+        if (strokes[i].noise > 0.0) noise_[i] = strokeNoise(i, strokes[i].force.size(), strokes[i].noise, 0);
+    });
+}
+
 StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector<double>* head, double jitterF, double jitterA,
                                 std::uint64_t noiseSeed) const
 {
@@ -130,9 +149,9 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
     ++simulations_;
     if (head) head->assign(out.begin(), out.begin() + static_cast<long>(std::min(out.size(), static_cast<std::size_t>(12.0 * fs_ / info_.f0 + 0.02 * fs_))));
     if (p.noise > 0.0) {
-        std::mt19937_64 rng(0x9e3779b97f4a7c15ull * (i + 1) + noiseSeed);
-        std::normal_distribution<double> g(0.0, p.noise);
-        for (double& x : out) x += g(rng);
+        const std::vector<double> drawn = noiseSeed == 0 && noise_[i].size() == out.size() ? std::vector<double>{} : strokeNoise(i, out.size(), p.noise, noiseSeed);
+        const std::vector<double>& add = drawn.empty() ? noise_[i] : drawn;
+        for (std::size_t n = 0; n < out.size(); ++n) out[n] += add[n];
     }
     return features(std::move(out), fs_, p.gesture, info_, true);
 }

@@ -129,8 +129,8 @@ SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts);
 
 class Engine {
 public:
-    Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady)
-        : strokes_(strokes), info_(info), fs_(fs), steady_(steady) {}
+    /// The strokes must keep their length and noise level while the engine lives.
+    Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady);
 
     /// The voice of model m: its effects, the set's steady-sliding curve and the nuisances.
     dsp::BowedStringConfig config(const EffectModel& m) const;
@@ -155,6 +155,8 @@ private:
     StringInfo info_;
     double fs_;
     std::optional<dsp::SteadyCurve> steady_;
+    /// Each stroke's own noise (seed 0), drawn once: every evaluation adds the same to that stroke.
+    std::vector<std::vector<double>> noise_;
     mutable std::atomic<long long> simulations_{0};
     mutable tbb::enumerable_thread_specific<Voice> voices_;
 };
