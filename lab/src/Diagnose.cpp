@@ -407,10 +407,17 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             for (std::size_t k = 0; k < names.size(); ++k) {
                 const auto kk = static_cast<Eigen::Index>(k);
                 const double v = x[kk], hw = 1.96 * std::sqrt(std::max(0.0, cov(kk, kk)));
+                // The fits never leave the search range, so neither does the interval; one that
+                // spans all of it (a direction with no curvature) marks a parameter not identified.
+                const auto [bottom, top] = parameterBounds().at(names[k]);
+                const double lo = std::max(v - hw, bottom), hi = std::min(v + hw, top);
                 if (isNuisance(names[k]))
-                    d.calibration.push_back({names[k], nuisanceMeaning(names[k]), v, v - hw, v + hw});
+                    d.calibration.push_back({names[k], nuisanceMeaning(names[k]), v, lo, hi});
                 for (auto& f : d.findings)
-                    if (f.parameters.count(names[k])) f.curvature[names[k]] = {v - hw, v + hw};
+                    if (f.parameters.count(names[k])) {
+                        f.curvature[names[k]] = {lo, hi};
+                        if (lo <= bottom && hi >= top) f.unidentified.insert(names[k]);
+                    }
             }
         }
     }

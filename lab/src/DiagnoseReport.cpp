@@ -194,6 +194,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             params[name] = {{"value", v[0]}, {"ci95", {lo, hi}}, {"ci95_bootstrap", {v[1], v[2]}}};
             if (f.curvature.count(name)) params[name]["ci95_curvature"] = f.curvature.at(name);
             if (f.halves.count(name)) params[name]["drive_halves"] = f.halves.at(name);
+            params[name]["identified"] = !f.unidentified.count(name);
         }
         findings.push_back({{"effect", f.effect}, {"evidence", f.evidence}, {"parameters", params},
                             {"heldout_error_before", f.heldoutBefore}, {"heldout_error_after", f.heldoutAfter}});
@@ -306,6 +307,9 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             md << "| " << name << " | " << fmt(v[0]) << " | " << fmt(lo) << " – " << fmt(hi) << " | " << fmt(v[1]) << " – " << fmt(v[2]) << " | "
                << range(f.curvature, name, " – ") << " | " << range(f.halves, name, " / ") << " |\n";
         }
+        for (const auto& name : f.unidentified)
+            md << "\n" << name << " is not identified: the errors do not change along it at the fit (no curvature), so its "
+               << "interval is its whole search range and its value is whatever the search stopped at.\n";
         md << "\n";
     }
     const BoundaryFit bm = fitLowerBoundary(measured), bb = fitLowerBoundary(base), bf = fitLowerBoundary(fin);

@@ -74,6 +74,7 @@ struct Scored {
     std::map<std::string, std::array<double, 3>> estimate; ///< value, ci low, ci high
     /// the interval without the drive halves' refits (bootstrap and curvature only), where given
     std::map<std::string, std::array<double, 2>> withoutHalves;
+    std::set<std::string> unidentified; ///< reported as not identified: interval = search range
     std::map<std::string, std::array<double, 3>> calibration; ///< nuisance -> value, ci low, ci high
     std::map<std::string, double> rig;
     double baseline = 0, final = 0;
@@ -263,6 +264,7 @@ std::string scoreStudy(const fs::path& dir)
             s.found.push_back(e);
             for (const auto& [name, v] : finding["parameters"].items()) {
                 s.estimate[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
+                if (v.contains("identified") && !v["identified"].get<bool>()) s.unidentified.insert(name);
                 if (v.contains("ci95_bootstrap")) {
                     std::array<double, 2> w{v["ci95_bootstrap"][0].get<double>(), v["ci95_bootstrap"][1].get<double>()};
                     if (v.contains("ci95_curvature"))
@@ -340,7 +342,7 @@ std::string scoreStudy(const fs::path& dir)
     int covered = 0, intervals = 0, coveredWithoutHalves = 0;
     for (const std::string& p : parameterNames()) {
         std::vector<double> err;
-        int within = 0, inside = 0;
+        int within = 0, inside = 0, unidentified = 0;
         const Tolerance tol = tolerances().at(p);
         for (const auto& s : sets) {
             if (!s.truth.count(p) || !s.estimate.count(p) || !has(s.found, effectOfParameter(p))) continue;
@@ -348,6 +350,12 @@ std::string scoreStudy(const fs::path& dir)
             const double e = tol.relative ? std::abs(v / t - 1.0) : std::abs(v - t);
             err.push_back(e);
             within += e <= tol.value;
+            // An interval as wide as the search range holds any truth and says nothing: such a
+            // parameter is counted apart, not as covered.
+            if (s.unidentified.count(p)) {
+                ++unidentified;
+                continue;
+            }
             const bool in = t >= s.estimate.at(p)[1] && t <= s.estimate.at(p)[2];
             inside += in;
             covered += in;
@@ -363,11 +371,12 @@ std::string scoreStudy(const fs::path& dir)
         const char* unit = tol.relative ? "%.1f %%" : "%.3g";
         const double k = tol.relative ? 100.0 : 1.0;
         md << "| " << p << " | " << err.size() << " | " << fmt(unit, k * err[err.size() / 2]) << " | " << fmt(unit, k * err.back()) << " | "
-           << within << " (tolerance " << fmt(unit, k * tol.value) << ") | " << inside << " of " << err.size() << " |\n";
+           << within << " (tolerance " << fmt(unit, k * tol.value) << ") | " << inside << " of " << err.size() - static_cast<std::size_t>(unidentified)
+           << (unidentified ? " (" + std::to_string(unidentified) + " not identified)" : std::string()) << " |\n";
         summary["parameters"][p] = {{"named", err.size()}, {"median_error", err[err.size() / 2]}, {"worst_error", err.back()},
-                                    {"within_tolerance", within}, {"covered", inside}};
+                                    {"within_tolerance", within}, {"covered", inside}, {"not_identified", unidentified}};
     }
-    md << fmt("\nCoverage of the 95 %% intervals over all named parameters: %.0f %%", intervals ? 100.0 * covered / intervals : 0.0)
+    md << fmt("\nCoverage of the 95 %% intervals over all named parameters that the data identify: %.0f %%", intervals ? 100.0 * covered / intervals : 0.0)
        << " (" << covered << " of " << intervals << ")"
        << fmt("; without the drive halves' refits (bootstrap and curvature only): %.0f %%", intervals ? 100.0 * coveredWithoutHalves / intervals : 0.0)
        << " (" << coveredWithoutHalves << ").\n";

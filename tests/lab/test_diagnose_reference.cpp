@@ -76,23 +76,37 @@ void expectDiagnosis(const Outcome& o)
         tried += ": " + t.verdict + "]";
     }
     EXPECT_EQ(found, want) << "tried:" << tried;
+    // The search ranges (docs/diagnosis.md): no interval reaches past them.
+    const std::map<std::string, std::pair<double, double>> range{{"r_A", {0.5, 2.0}},          {"h0", {0.3, 1.2}},         {"p", {0.1, 0.8}},
+                                                                 {"load_exponent", {0.4, 1.1}}, {"shift_k", {-30.0, 30.0}}, {"zt_ratio", {0.7, 8.0}}};
     for (const auto& f : o.d.findings)
         for (const auto& [name, v] : f.parameters) {
             ASSERT_TRUE(o.truth.params.count(name)) << name;
             const double t = o.truth.params.at(name);
+            const auto [lo, hi] = reportedInterval(f, name);
+            EXPECT_GE(lo, range.at(name).first) << name;
+            EXPECT_LE(hi, range.at(name).second) << name;
             if (name == "h0") {
                 // h0 cancels out of the enhanced law when y(theta) is the inversion of steady
-                // sliding (y h = mu_ss(v_theta) h(x) / h(v_theta)): no data can fix it, so its
-                // interval must say so rather than claim a value.
-                EXPECT_GT(v[2] - v[1], 0.2) << "h0 interval " << v[1] << ".." << v[2];
+                // sliding (y h = mu_ss(v_theta) h(x) / h(v_theta)): no data can fix it, so the
+                // report must say so rather than claim a value (it once printed +-2e6).
+                EXPECT_TRUE(f.unidentified.count("h0")) << "h0 interval " << lo << ".." << hi;
+                EXPECT_NEAR(hi - lo, 0.9, 1e-9) << "not identified: the whole search range";
                 continue;
             }
+            EXPECT_FALSE(f.unidentified.count(name)) << name;
             const Tolerance tol = kTolerance.at(name);
             const double err = tol.relative ? std::abs(v[0] / t - 1.0) : std::abs(v[0] - t);
             EXPECT_LE(err, tol.value) << name << " found " << v[0] << " hidden " << t;
         }
 }
 } // namespace
+
+// Rate dependence on a thermal rig: named with its exponent p, and h0 reported as not identified.
+TEST(DiagnoseReference, FindsRateDependenceAndSaysH0IsNotIdentified)
+{
+    expectDiagnosis(run({"rate_dependence"}, {{"r_A", 1.0}, {"h0", 0.6}, {"p", 0.45}}, 61));
+}
 
 TEST(DiagnoseReference, NamesNothingOnANullRig)
 {

@@ -246,3 +246,30 @@ TEST(Study, ScoringAnEmptyFolderSaysSo)
     EXPECT_THROW(scoreStudy(dir), LabError);
     fs::remove_all(dir);
 }
+
+// A parameter the diagnosis reports as not identified (its interval is its whole search range)
+// holds any truth: it is counted apart and left out of the coverage, while its error still counts.
+TEST(Study, LeavesParametersThatAreNotIdentifiedOutOfTheCoverage)
+{
+    const fs::path dir = freshDir("unidentified");
+    json rate = {{"effect", "rate_dependence"},
+                 {"parameters",
+                  {{"h0", {{"value", 0.9}, {"ci95", {0.3, 1.2}}, {"identified", false}}},
+                   {"p", {{"value", 0.45}, {"ci95", {0.35, 0.5}}, {"identified", true}}}}}};
+    json thermal = finding("thermal_memory", "r_A", 1.0, 0.9, 1.02); // for 1.05: missed
+    writeSet(dir, 0, {{"effects", {"thermal_memory", "rate_dependence"}}, {"params", {{"r_A", 1.05}, {"h0", 0.6}, {"p", 0.4}}}},
+             diagnosis(json::array({thermal, rate})));
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    const json& s = study["summary"];
+    EXPECT_EQ(s["parameters"]["h0"]["named"], 1);
+    EXPECT_EQ(s["parameters"]["h0"]["not_identified"], 1);
+    EXPECT_EQ(s["parameters"]["h0"]["covered"], 0);
+    EXPECT_NEAR(s["parameters"]["h0"]["worst_error"].get<double>(), 0.3, 1e-9);
+    EXPECT_EQ(s["parameters"]["p"]["covered"], 1);
+    // p covered, r_A missed, h0 not counted: 1 of 2.
+    EXPECT_NEAR(s["coverage"].get<double>(), 0.5, 1e-12);
+    EXPECT_NE(md.find("0 of 0 (1 not identified)"), std::string::npos) << md;
+    fs::remove_all(dir);
+}

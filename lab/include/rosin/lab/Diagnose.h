@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,9 @@ struct Finding {
     /// name -> {low-drive half, high-drive half}: the parameter refitted on each half of the fit
     /// strokes (rule 5), moved with the parameter when later rounds refit it
     std::map<std::string, std::vector<double>> halves;
+    /// Parameters the data do not constrain: the local curvature along them is nil, so their
+    /// curvature interval is their whole search range and their value says nothing.
+    std::set<std::string> unidentified;
     double heldoutBefore = 0, heldoutAfter = 0;            ///< validation error before and after
 };
 
