@@ -410,11 +410,18 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 // The fits never leave the search range, so neither does the interval; one that
                 // spans all of it (a direction with no curvature) marks a parameter not identified.
                 const auto [bottom, top] = parameterBounds().at(names[k]);
-                const double lo = std::max(v - hw, bottom), hi = std::min(v + hw, top);
+                // h0 cancels out of the enhanced law (docs/diagnosis.md): whatever curvature the
+                // chaotic errors show along it is noise, so its interval is its whole range.
+                const bool cancels = names[k] == "h0";
+                const double lo = cancels ? bottom : std::max(v - hw, bottom), hi = cancels ? top : std::min(v + hw, top);
                 if (isNuisance(names[k]))
                     d.calibration.push_back({names[k], nuisanceMeaning(names[k]), v, lo, hi});
                 for (auto& f : d.findings)
                     if (f.parameters.count(names[k])) {
+                        // the bootstrap's normal interval and the moved halves stay inside the range too
+                        for (auto* m : {&f.parameters, &f.halves})
+                            if (m->count(names[k]))
+                                for (double& x2 : m->at(names[k])) x2 = std::clamp(x2, bottom, top);
                         f.curvature[names[k]] = {lo, hi};
                         if (lo <= bottom && hi >= top) f.unidentified.insert(names[k]);
                     }
