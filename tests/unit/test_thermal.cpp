@@ -186,24 +186,6 @@ TEST(ThermalModel, SteadySlidingReproducesTheFitWithinOnePercent)
     }
 }
 
-// The footprint ratio r_A is the bow's contact area over the steady test's, so the heat spreads
-// over the bow's own footprint r_A K_A F (K_A from the steady test's 250 um at 1 N). (The model
-// once scaled only the friction by r_A and heated the steady test's footprint; the reference
-// simulator heats the bow's.)
-TEST(ThermalModel, TheFootprintRatioSetsTheHeatedFootprint)
-{
-    for (double ratio : {0.5, 1.0, 1.6}) {
-        FrictionParams fp;
-        fp.model = FrictionModel::Thermal;
-        fp.thermal.footprintRatio = ratio;
-        BowJunction<double> j;
-        j.prepare(48000.0, fp);
-        const double v = 0.2, force = 1.3;
-        for (int n = 0; n < 480; ++n) j.solve(0.0, v, force, 1e9); // clamped string: slips at v
-        EXPECT_NEAR(j.thermal().footprintArea() / (ratio * std::numbers::pi * 250e-6 * 250e-6 * force), 1.0, 1e-12) << "r_A " << ratio;
-    }
-}
-
 TEST(ContactArea, HertzFrictionScalesAsTwoThirdsPowerOfForce)
 {
     for (FrictionModel model : {FrictionModel::FrictionCurve, FrictionModel::Thermal, FrictionModel::Enhanced}) {
