@@ -165,7 +165,9 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
             }
         }
         const std::vector<std::vector<double>> fixedAll = gram(cols, static_cast<std::size_t>(end));
-        std::vector<std::vector<double>> fixedRest = fixedAll; // without the ramp's row and column
+        // With the gain known the ramp is subtracted and only these fixed columns are fitted.
+        std::vector<std::vector<double>> rest(cols), fixedRest = fixedAll; // without the ramp's row and column
+        rest.erase(rest.begin() + 1);
         fixedRest.erase(fixedRest.begin() + 1);
         for (auto& row : fixedRest) row.erase(row.begin() + 1);
         // Trigger search: coarse grid over the pre-slip time, then refined around the best.
@@ -183,8 +185,6 @@ RampFit calibrate(const std::vector<double>& f, const ClassifierInput& in, int r
                 if (in.knownGain > 0.0 && !in.rampShape) {
                     // Gain known: subtract the ramp, fit only DC and hum.
                     for (int i = 0; i < end; ++i) y[i] -= in.knownGain * cols[1][i];
-                    std::vector<std::vector<double>> rest(cols);
-                    rest.erase(rest.begin() + 1);
                     c = leastSquares(rest, y, fixedRest, rest.size());
                     c.insert(c.begin() + 1, in.knownGain);
                     for (int i = 0; i < end; ++i) y[i] += in.knownGain * cols[1][i];

@@ -149,8 +149,8 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
     ++simulations_;
     if (head) head->assign(out.begin(), out.begin() + static_cast<long>(std::min(out.size(), static_cast<std::size_t>(12.0 * fs_ / info_.f0 + 0.02 * fs_))));
     if (p.noise > 0.0) {
-        const std::vector<double> drawn = noiseSeed == 0 && noise_[i].size() == out.size() ? std::vector<double>{} : strokeNoise(i, out.size(), p.noise, noiseSeed);
-        const std::vector<double>& add = drawn.empty() ? noise_[i] : drawn;
+        const std::vector<double> other = noiseSeed == 0 ? std::vector<double>{} : strokeNoise(i, out.size(), p.noise, noiseSeed);
+        const std::vector<double>& add = noiseSeed == 0 ? noise_[i] : other;
         for (std::size_t n = 0; n < out.size(); ++n) out[n] += add[n];
     }
     return features(std::move(out), fs_, p.gesture, info_, true);
