@@ -410,10 +410,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 // The fits never leave the search range, so neither does the interval; one that
                 // spans all of it (a direction with no curvature) marks a parameter not identified.
                 const auto [bottom, top] = parameterBounds().at(names[k]);
-                // h0 cancels out of the enhanced law (docs/diagnosis.md): whatever curvature the
-                // chaotic errors show along it is noise, so its interval is its whole range.
-                const bool cancels = names[k] == "h0";
-                const double lo = cancels ? bottom : std::max(v - hw, bottom), hi = cancels ? top : std::min(v + hw, top);
+                // (a parameter that cancels out of the model gets its whole range, whatever the curvature)
+                const bool canFix = identifiable(names[k]);
+                const double lo = canFix ? std::max(v - hw, bottom) : bottom, hi = canFix ? std::min(v + hw, top) : top;
                 if (isNuisance(names[k]))
                     d.calibration.push_back({names[k], nuisanceMeaning(names[k]), v, lo, hi});
                 for (auto& f : d.findings)

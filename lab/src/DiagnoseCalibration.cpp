@@ -143,17 +143,20 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     // The median's own spread, from resampled strokes.
     double gainLow = gain, gainHigh = gain;
     if (used.size() >= 3) {
+        constexpr int kResamples = 400;
         std::mt19937_64 rng(o.seed * 7919ull + 11ull);
         std::uniform_int_distribution<std::size_t> pick(0, used.size() - 1);
         std::vector<double> medians;
-        for (int b = 0; b < 400; ++b) {
+        for (int b = 0; b < kResamples; ++b) {
             std::vector<double> r(used.size());
             for (auto& x : r) x = used[pick(rng)];
             medians.push_back(median(std::move(r)));
         }
         std::sort(medians.begin(), medians.end());
-        gainLow = medians[10];
-        gainHigh = medians[389];
+        // the 2.5 % and 97.5 % points of the sorted medians (indices 10 and 389 of 400)
+        auto at = [&](double q) { return medians[static_cast<std::size_t>(std::lround(q * (kResamples - 1)))]; };
+        gainLow = at(0.025);
+        gainHigh = at(0.975);
     }
     if (!(gain > 0)) gain = gainLow = gainHigh = 1.0;
     if (set.units == "N") {

@@ -123,6 +123,8 @@ const std::map<std::string, std::pair<double, double>>& parameterBounds()
     return b;
 }
 
+bool identifiable(const std::string& parameter) { return parameter != "h0"; }
+
 /// True when the fitted parameters put the effect at its own absence (Hertz exponent 1 is
 /// Amontons, a shift of 0 K is the reference rosin, a very stiff torsion is no torsion): any
 /// held-out "gain" it shows is then the chaos of transients, not physics.

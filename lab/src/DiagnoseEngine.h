@@ -85,6 +85,10 @@ struct Candidate {
 
 /// Bounds of every parameter any extension has (for the joint refit).
 const std::map<std::string, std::pair<double, double>>& parameterBounds();
+/// False for a parameter no data can fix: h0 cancels out of the enhanced law when y(theta) is the
+/// inversion of steady sliding (docs/diagnosis.md), so whatever curvature the chaotic errors show
+/// along it is noise and its interval is its whole search range.
+bool identifiable(const std::string& parameter);
 /// A candidate adding `effect` with the given parameters, bounded by parameterBounds().
 Candidate candidate(const std::string& effect, std::vector<std::string> names, std::vector<double> start);
 /// The candidate with the model's nuisances, and the parameters of effects already named, free too.
