@@ -41,6 +41,10 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
         c.lo.push_back(parameterBounds().at(k.name).first);
         c.hi.push_back(parameterBounds().at(k.name).second);
         c.start.push_back(m.params.count(k.name) ? m.params.at(k.name) : 1.0);
+        // Thermal memory alone is the yardstick a rate dependence or a rosin shift must beat, and
+        // those have a grid over two or three dimensions: searched over r_A alone, it would leave
+        // the bow side's effusivity where it starts and lose to a shift standing in for it.
+        if (k.thermalOnly && c.effect == "thermal_memory") c.gridAlso.push_back(c.names.size() - 1);
     }
     return c;
 }
@@ -157,17 +161,23 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
     std::vector<double> x(n);
     for (std::size_t k = 0; k < n; ++k) x[k] = (start[k] - c.lo[k]) / (c.hi[k] - c.lo[k]);
     if (scan) {
+        // The candidate's own parameters get the resolution their number allows; a further
+        // parameter (gridAlso) only three points, enough to choose the basin COBYLA refines.
         const std::size_t ns = c.scanned > 0 ? c.scanned : n;
         const int per = ns == 1 ? 7 : ns == 2 ? 5 : 3;
+        std::vector<std::pair<std::size_t, int>> dims; // (parameter, points)
+        for (std::size_t k = 0; k < ns; ++k) dims.push_back({k, per});
+        if (c.scanned > 0)
+            for (const std::size_t k : c.gridAlso) dims.push_back({k, 3});
         int total = 1;
-        for (std::size_t k = 0; k < ns; ++k) total *= per;
+        for (const auto& d : dims) total *= d.second;
         double bestGrid = 1e300;
         for (int g = 0; g < total; ++g) {
             std::vector<double> u = x, v(n);
             int rest = g;
-            for (std::size_t k = 0; k < ns; ++k) {
-                u[k] = (rest % per + 0.5) / per;
-                rest /= per;
+            for (const auto& [k, points] : dims) {
+                u[k] = (rest % points + 0.5) / points;
+                rest /= points;
             }
             for (std::size_t k = 0; k < n; ++k) v[k] = c.lo[k] + u[k] * (c.hi[k] - c.lo[k]);
             const double e = mean(engine.errors(apply(base, c, v), on));

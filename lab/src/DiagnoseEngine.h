@@ -81,6 +81,7 @@ struct Candidate {
     std::vector<std::string> adds, names;
     std::vector<double> lo, hi, start;
     std::size_t scanned = 0; ///< the grid covers the first `scanned` parameters (0: all); the rest start where they are
+    std::vector<std::size_t> gridAlso; ///< further parameters (by index) the grid covers, though they are not the candidate's own
 };
 
 /// Bounds of every parameter any extension has (for the joint refit).
