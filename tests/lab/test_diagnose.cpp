@@ -27,7 +27,8 @@ struct Case {
     bool torsionMayHide = false; ///< the long run: a set with torsion may name less, never more
 };
 
-void check(const Case& k)
+/// The case's 8x8 model-made set, written to disk, read back and diagnosed as the CLI would.
+Diagnosis diagnoseModelSet(const Case& k, SynthTruth& truth)
 {
     const fs::path dir = fs::temp_directory_path() / ("rosin-diag-" + std::to_string(::getpid()) + "-" + std::to_string(k.seed));
     fs::remove_all(dir);
@@ -38,12 +39,18 @@ void check(const Case& k)
     spec.grid = 8;
     spec.outRate = k.rate;
     spec.gaussianReflections = k.gaussian;
-    SynthTruth truth;
     writeMeasurementSet(dir / "set", synthesize(spec, truth), SF_FORMAT_PCM_24);
     DiagnoseOptions o;
     o.seed = 5;
-    const Diagnosis d = diagnose(readMeasurementSet(dir / "set"), o);
+    Diagnosis d = diagnose(readMeasurementSet(dir / "set"), o);
     fs::remove_all(dir);
+    return d;
+}
+
+void check(const Case& k)
+{
+    SynthTruth truth;
+    const Diagnosis d = diagnoseModelSet(k, truth);
 
     std::vector<std::string> found;
     for (const auto& f : d.findings) found.push_back(f.effect);
@@ -102,19 +109,8 @@ TEST(DiagnoseConsistency, FindsThermalMemoryWithARosinTemperatureShift) { check(
 // nominal value, and the shift must be in the trials: nothing hidden silently, nothing mislabelled.
 TEST(DiagnoseConsistency, AShiftTheBowsEffusivityCanMimicIsNamedOrShownInTheCalibration)
 {
-    const fs::path dir = fs::temp_directory_path() / ("rosin-diag-mimic-" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    SynthSpec spec;
-    spec.effects = {"rosin_temperature_shift"};
-    spec.seed = 24;
-    spec.grid = 8;
     SynthTruth truth;
-    writeMeasurementSet(dir / "set", synthesize(spec, truth), SF_FORMAT_PCM_24);
-    DiagnoseOptions o;
-    o.seed = 5;
-    const Diagnosis d = diagnose(readMeasurementSet(dir / "set"), o);
-    fs::remove_all(dir);
+    const Diagnosis d = diagnoseModelSet({{"rosin_temperature_shift"}, 24}, truth);
     ASSERT_NEAR(truth.params.at("shift_k"), -16.8, 0.1);
     std::vector<std::string> found;
     for (const auto& f : d.findings) found.push_back(f.effect);

@@ -199,7 +199,7 @@ TEST(DiagnoseReferenceLong, MixedSetsFindThermalMemoryAndMostOfTheirFootprints)
         const Outcome o = run({"thermal_memory"}, {{"r_A", 0.8}}, seed, 8, "mixed");
         const auto thermal = std::find_if(o.d.findings.begin(), o.d.findings.end(), [](const Finding& f) { return f.effect == "thermal_memory"; });
         ASSERT_NE(thermal, o.d.findings.end()) << "seed " << seed;
-        within += std::abs(thermal->parameters.at("r_A")[0] / 0.8 - 1.0) <= 0.1;
+        within += std::abs(thermal->parameters.at("r_A")[0] / 0.8 - 1.0) <= kTolerance.at("r_A").value;
     }
     EXPECT_GE(within, 4);
 }
