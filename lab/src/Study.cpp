@@ -207,8 +207,14 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         std::snprintf(name, sizeof name, "%03d", p.index);
         const fs::path here = dir / "sets" / name;
         if (fs::exists(here / "diagnosis" / "diagnosis.json")) continue; // resumed study: already done
-        fs::remove_all(here);
-        fs::create_directories(here);
+        // A set kept by an earlier run (--keep-sets, --generate-only) is diagnosed as it is: the
+        // reference simulation is most of a set's time.
+        const bool kept = fs::exists(here / "truth.json") && fs::exists(here / "set" / "manifest.json");
+        if (kept && o.generateOnly) continue;
+        if (!kept) {
+            fs::remove_all(here);
+            fs::create_directories(here);
+        }
         auto say = [&](const std::string& what, double x) {
             if (progress) progress("set " + std::string(name) + " (" + joined(p.effects) + "): " + what, (static_cast<double>(done - 1) + x) / static_cast<double>(plan.size()));
         };
@@ -220,11 +226,15 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         spec.oversampling = o.oversampling;
         spec.gesture = o.gesture;
         if (o.gesture == "exp_force") spec.units = "N";
-        SynthTruth truth;
-        say("simulating", 0.0);
-        const MeasurementSet made = synthesize(spec, truth, [&](double x) { say("simulating", 0.5 * x); });
-        writeTruth(here / "truth.json", truth, p.seed);
-        writeMeasurementSet(here / "set", made, spec.units == "N" ? SF_FORMAT_FLOAT : SF_FORMAT_PCM_24); // newtons pass PCM's full scale
+        if (!kept) {
+            SynthTruth truth;
+            say("simulating", 0.0);
+            const MeasurementSet made = synthesize(spec, truth, [&](double x) { say("simulating", (o.generateOnly ? 1.0 : 0.5) * x); });
+            // the truth last, so a set with a truth.json is whole
+            writeMeasurementSet(here / "set", made, spec.units == "N" ? SF_FORMAT_FLOAT : SF_FORMAT_PCM_24); // newtons pass PCM's full scale
+            writeTruth(here / "truth.json", truth, p.seed);
+        }
+        if (o.generateOnly) continue;
         const MeasurementSet set = readMeasurementSet(here / "set");
         DiagnoseOptions d = o.diagnose;
         d.quiet = true;
@@ -232,7 +242,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         const fs::path tmp = here / ".diagnosis.partial";
         writeDiagnosis(tmp, result, d);
         fs::rename(tmp, here / "diagnosis");
-        if (!o.keepSets) fs::remove_all(here / "set");
+        if (!o.keepSets && !kept) fs::remove_all(here / "set");
     }
     mpi.barrier();
 }

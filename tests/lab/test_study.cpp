@@ -106,6 +106,36 @@ TEST(Study, AFolderResumesOnlyTheStudyItHolds)
     fs::remove_all(dir);
 }
 
+// Sets can be simulated on one occasion and diagnosed on another (a new diagnosis on the same
+// data): the second run diagnoses the kept set as it is and simulates nothing again.
+TEST(Study, GenerateOnlyKeepsTheSetsAndALaterRunDiagnosesThem)
+{
+    const fs::path dir = freshDir("generate");
+    StudyOptions o;
+    o.sets = 1;
+    o.nulls = 1;
+    o.grid = 4; // 16 strokes: the fewest a diagnosis splits
+    o.seed = 11;
+    o.generateOnly = true;
+    runStudy(dir, o);
+    const fs::path set = dir / "sets" / "000";
+    ASSERT_TRUE(fs::exists(set / "truth.json"));
+    ASSERT_TRUE(fs::exists(set / "set" / "manifest.json"));
+    EXPECT_FALSE(fs::exists(set / "diagnosis"));
+    const auto made = fs::last_write_time(set / "truth.json");
+    const auto manifest = fs::last_write_time(set / "set" / "manifest.json");
+    o.generateOnly = false;
+    o.diagnose.maxEvaluations = 5;
+    o.diagnose.parameterBootstrap = 2;
+    o.diagnose.bootstrap = 200;
+    runStudy(dir, o);
+    EXPECT_TRUE(fs::exists(set / "diagnosis" / "diagnosis.json"));
+    EXPECT_EQ(fs::last_write_time(set / "truth.json"), made) << "the kept set was simulated again";
+    EXPECT_EQ(fs::last_write_time(set / "set" / "manifest.json"), manifest);
+    EXPECT_TRUE(fs::exists(set / "set" / "manifest.json")) << "a kept set stays kept";
+    fs::remove_all(dir);
+}
+
 TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
 {
     const fs::path dir = freshDir("score");

@@ -35,6 +35,8 @@ struct StudyCommand {
         cmd->add_option("--oversampling", options.oversampling, "Reference simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         cmd->add_option("--diagnose-seed", options.diagnose.seed, "Seed of each diagnosis's split and bootstraps")->capture_default_str();
         cmd->add_flag("--keep-sets", options.keepSets, "Keep the generated WAV sets");
+        cmd->add_flag("--generate-only", options.generateOnly,
+                      "Only simulate the sets and keep them; a later run without it diagnoses the kept sets instead of simulating them again");
         cmd->add_flag("--score-only", scoreOnly, "Only score what OUT already holds");
         cmd->add_flag("-q,--quiet", options.quiet, "No progress and no summary");
         return cmd;
@@ -48,6 +50,10 @@ struct StudyCommand {
             progress.finish();
         }
         if (!Distributed::instance().isRoot()) return 0;
+        if (options.generateOnly) {
+            if (!options.quiet) std::printf("kept the sets in %s/sets; run again without --generate-only to diagnose them\n", out.c_str());
+            return 0;
+        }
         const std::string summary = scoreStudy(out);
         if (!options.quiet) std::printf("%s\nwrote %s/study.csv, study.json, summary.md, study.png\n", summary.c_str(), out.c_str());
         return 0;

@@ -25,6 +25,7 @@ struct StudyOptions {
     /// calibrated in newtons: rising-force strokes alone cannot set a volt scale) or mixed.
     std::string gesture = "guettler";
     bool keepSets = false;     ///< keep the generated WAV sets (regenerable from their seeds)
+    bool generateOnly = false; ///< simulate and keep the sets, diagnose none (a later run diagnoses the kept sets)
     DiagnoseOptions diagnose;
     bool quiet = false;
 };
