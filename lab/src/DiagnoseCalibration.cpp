@@ -43,6 +43,22 @@ Eigen::MatrixXd curvatureCovariance(const std::function<Eigen::VectorXd(const Ei
     return cov;
 }
 
+Eigen::VectorXd gaussNewtonShift(const Eigen::MatrixXd& J, const Eigen::VectorXd& dr)
+{
+    const Eigen::MatrixXd JtJ = J.transpose() * J;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(JtJ);
+    const double top = eig.eigenvalues().maxCoeff();
+    const Eigen::VectorXd g = J.transpose() * dr;
+    Eigen::VectorXd shift = Eigen::VectorXd::Zero(J.cols());
+    for (Eigen::Index k = 0; k < J.cols(); ++k) {
+        const double l = eig.eigenvalues()[k];
+        if (!(l > 1e-10 * top && l > 0)) continue;
+        const Eigen::VectorXd v = eig.eigenvectors().col(k);
+        shift -= (v.dot(g) / l) * v;
+    }
+    return shift;
+}
+
 SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts)
 {
     auto curve = [](const Eigen::VectorXd& q) {

@@ -81,6 +81,15 @@ ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gestu
     return e;
 }
 
+std::array<double, 4> signedParts(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g)
+{
+    if (m.firstSlip < 0 || s.firstSlip < 0) return {0, 0, 0, 0};
+    const double F = g.force;
+    const double nm = m.transientPeriods < 0 ? 30 : m.transientPeriods, ns = s.transientPeriods < 0 ? 30 : s.transientPeriods;
+    return {0.25 * (s.firstSlip - m.firstSlip) / m.firstSlip, 0.25 * (s.forceBeforeSlip - m.forceBeforeSlip) / F,
+            0.25 * (s.firstDrop - m.firstDrop) / F, 0.10 * (ns - nm) / 25.0};
+}
+
 double mean(const std::vector<ErrorParts>& e)
 {
     double s = 0;
@@ -98,6 +107,7 @@ dsp::BowedStringConfig Engine::config(const EffectModel& m) const
     c.string.tension = info_.tension * get("tension_scale");
     c.string.massPerLength = c.string.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
     c.friction.thermal.rodEffusivity *= get("rod_effusivity_scale");
+    c.friction.thermal.contactRadiusAtRef *= get("contact_radius_scale");
     return c;
 }
 
@@ -164,6 +174,17 @@ std::vector<ErrorParts> Engine::errors(const EffectModel& m, const std::vector<s
         e[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].gesture, info_);
     });
     return e;
+}
+
+Eigen::VectorXd Engine::signedResiduals(const EffectModel& m, const std::vector<std::size_t>& which) const
+{
+    Eigen::VectorXd r(static_cast<Eigen::Index>(4 * which.size()));
+    tbb::parallel_for(std::size_t(0), which.size(), [&](std::size_t k) {
+        const std::size_t i = which[k];
+        const auto p = signedParts(strokes_[i].feat, simulate(m, i), strokes_[i].gesture);
+        for (std::size_t j = 0; j < 4; ++j) r[static_cast<Eigen::Index>(4 * k + j)] = p[j];
+    });
+    return r;
 }
 
 } // namespace rosin::lab::diag

@@ -45,6 +45,9 @@ StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, cons
 /// waveform is measured against the flyback the bow speed at the measured first slip would give.
 ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info);
 double mean(const std::vector<ErrorParts>& e);
+/// The metric's first four parts with their signs (simulated - measured, scaled and weighted as
+/// in the metric, not capped): what a linearised fit can take up. Zero where a stroke has no slip.
+std::array<double, 4> signedParts(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g);
 inline double median(std::vector<double> v)
 {
     if (v.empty()) return 0.0;
@@ -72,6 +75,18 @@ const std::vector<Nuisance>& nuisances();
 bool isNuisance(const std::string& p);
 /// What a nuisance's value means, in the report's words.
 std::string nuisanceMeaning(const std::string& p);
+
+/// A rig property that neither the fits nor the metric can fix, set to one end of its prior:
+/// the model gets `adds` and the fixed `params` (not fitted), and the final model is refitted.
+struct RigUnknown {
+    std::string name;
+    std::string setting;
+    std::vector<std::string> adds;
+    std::map<std::string, double> params;
+};
+/// The rig unknowns that matter to model m (the contact radius to a thermal model; torsion when
+/// it is not in the model).
+std::vector<RigUnknown> rigUnknowns(const EffectModel& m);
 
 class Engine;
 
@@ -123,6 +138,9 @@ std::vector<bool> upperDriveHalf(const std::vector<std::size_t>& from, const std
 /// huge variance instead of a made-up one.
 Eigen::MatrixXd curvatureCovariance(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& residuals, const Eigen::VectorXd& x,
                                     const Eigen::VectorXd& steps);
+/// The Gauss-Newton move of the parameters that takes up a change dr of the residuals, given their
+/// Jacobian (directions without curvature do not move).
+Eigen::VectorXd gaussNewtonShift(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& dr);
 
 /// The rig's steady-sliding curve from its steady_sliding.csv: the SW00 shape with four factors
 /// (level, the two speed scales, the high-speed floor) by Levenberg-Marquardt on relative residuals.
@@ -148,6 +166,8 @@ public:
     StrokeFeatures simulate(const EffectModel& m, std::size_t i, std::vector<double>* head = nullptr, double jitterF = 0.0,
                             double jitterA = 0.0, std::uint64_t noiseSeed = 0) const;
     std::vector<ErrorParts> errors(const EffectModel& m, const std::vector<std::size_t>& which) const;
+    /// signedParts of every stroke in `which`, one after the other.
+    Eigen::VectorXd signedResiduals(const EffectModel& m, const std::vector<std::size_t>& which) const;
     long long simulations() const { return simulations_.load(); }
     const StringInfo& info() const { return info_; }
 

@@ -168,7 +168,19 @@ std::string describe(const std::string& effect, const std::vector<ErrorParts>& b
 
 // Where the model misses part of the physics, a parameter depends on which strokes it is fitted
 // to, and resampling all of them does not show that: the drive halves' refits widen the interval.
-std::pair<double, double> reportedInterval(const Finding& f, const std::string& name)
+namespace {
+std::string discrepancyText(const DiagnoseOptions& o)
+{
+    std::string text;
+    for (const auto& [name, sd] : o.modelDiscrepancy)
+        if (sd > 0.0) text += " " + name + " " + (discrepancyIsRelative(name) ? fmt(100.0 * sd, "%.3g") + " % of its value" : fmt(sd, "%.3g")) + ",";
+    if (text.empty()) return " none";
+    text.pop_back();
+    return text;
+}
+} // namespace
+
+std::pair<double, double> statisticalInterval(const Finding& f, const std::string& name)
 {
     const std::vector<double>& v = f.parameters.at(name);
     double lo = v[1], hi = v[2];
@@ -178,6 +190,23 @@ std::pair<double, double> reportedInterval(const Finding& f, const std::string& 
                 lo = std::min(lo, x);
                 hi = std::max(hi, x);
             }
+    return {lo, hi};
+}
+
+// What the rig may be beyond the data's reach moves a parameter as surely as the strokes'
+// scatter does; the two are independent, so their half-widths add in quadrature. The interval
+// stays inside the search range, like every fit.
+std::pair<double, double> reportedInterval(const Finding& f, const std::string& name)
+{
+    auto [lo, hi] = statisticalInterval(f, name);
+    const auto s = f.systematic.find(name);
+    const auto m = f.discrepancy.find(name);
+    const double down = s != f.systematic.end() ? s->second[0] : 0.0, up = s != f.systematic.end() ? s->second[1] : 0.0;
+    const double model = m != f.discrepancy.end() ? m->second : 0.0;
+    const double v = f.parameters.at(name)[0];
+    const auto [bottom, top] = diag::parameterBounds().at(name);
+    lo = std::max(bottom, v - std::sqrt((v - lo) * (v - lo) + down * down + model * model));
+    hi = std::min(top, v + std::sqrt((hi - v) * (hi - v) + up * up + model * model));
     return {lo, hi};
 }
 
@@ -191,7 +220,10 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         json params = json::object();
         for (const auto& [name, v] : f.parameters) {
             const auto [lo, hi] = reportedInterval(f, name);
-            params[name] = {{"value", v[0]}, {"ci95", {lo, hi}}, {"ci95_bootstrap", {v[1], v[2]}}};
+            const auto [statLo, statHi] = statisticalInterval(f, name);
+            params[name] = {{"value", v[0]}, {"ci95", {lo, hi}}, {"ci95_statistical", {statLo, statHi}}, {"ci95_bootstrap", {v[1], v[2]}}};
+            if (f.systematic.count(name)) params[name]["systematic_moves"] = f.systematic.at(name);
+            if (f.discrepancy.count(name)) params[name]["model_discrepancy_halfwidth"] = f.discrepancy.at(name);
             if (f.curvature.count(name)) params[name]["ci95_curvature"] = f.curvature.at(name);
             if (f.halves.count(name)) params[name]["drive_halves"] = f.halves.at(name);
             params[name]["identified"] = !f.unidentified.count(name);
@@ -209,6 +241,8 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
                             {"heldout_error_before", d.baselineError}, {"heldout_error_after", d.finalError}});
     }
     json calibration{{"scale_n_per_unit", d.scale}, {"trigger_offsets_detected", d.triggersDetected}};
+    json rigUnknowns = json::array();
+    for (const auto& t : d.rigUnknowns) rigUnknowns.push_back({{"unknown", t.unknown}, {"setting", t.setting}, {"moves", t.moves}});
     for (const auto& c : d.calibration) calibration["values"][c.name] = {{"value", c.value}, {"ci95", {c.low, c.high}}, {"meaning", c.meaning}};
     json residual = nullptr;
     if (d.residual.present)
@@ -232,6 +266,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
                   {"baseline", d.baselineError}, {"final", d.finalError}, {"relative", d.relativeGain},
                   {"ci95", {d.gainLow, d.gainHigh}}, {"n_fit", d.nFit}, {"n_validation", d.nValidation}, {"n_heldout", d.nHeldout}}},
         {"calibration", calibration},
+        {"rig_unknowns", rigUnknowns},
         {"unexplained_residual", residual},
         {"floor", {{"error", d.residual.floor}, {"final_over_floor", d.residual.ratio}, {"final_parts", d.residual.partError},
                    {"floor_parts", d.residual.partFloor}}},
@@ -298,18 +333,36 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     if (d.findings.empty()) md << (d.residual.present ? "None named (see the unexplained residual).\n\n" : "None: the calibrated baseline explains the data within its floor.\n\n");
     for (const auto& f : d.findings) {
         md << "### " << f.effect << "\n\n" << f.evidence
-           << "\n\n| parameter | value | 95 % CI (reported) | bootstrap refits | curvature | low / high drive half |\n|---|---|---|---|---|---|\n";
+           << "\n\n| parameter | value | 95 % CI (reported) | bootstrap refits | curvature | low / high drive half | rig unknowns (down / up) | model discrepancy (+-) |\n|---|---|---|---|---|---|---|---|\n";
         auto range = [&](const std::map<std::string, std::vector<double>>& m, const std::string& name, const char* sep) {
             return m.count(name) ? fmt(m.at(name)[0]) + sep + fmt(m.at(name)[1]) : std::string("-");
         };
         for (const auto& [name, v] : f.parameters) {
             const auto [lo, hi] = reportedInterval(f, name);
             md << "| " << name << " | " << fmt(v[0]) << " | " << fmt(lo) << " – " << fmt(hi) << " | " << fmt(v[1]) << " – " << fmt(v[2]) << " | "
-               << range(f.curvature, name, " – ") << " | " << range(f.halves, name, " / ") << " |\n";
+               << range(f.curvature, name, " – ") << " | " << range(f.halves, name, " / ") << " | " << range(f.systematic, name, " / ") << " | " << (f.discrepancy.count(name) ? fmt(f.discrepancy.at(name)) : std::string("-")) << " |\n";
         }
         for (const auto& name : f.unidentified)
             md << "\n" << name << " is not identified: the errors do not change along it at the fit (no curvature), so its "
                << "interval is its whole search range and its value is whatever the search stopped at.\n";
+        md << "\n";
+    }
+    if (!d.rigUnknowns.empty()) {
+        md << "## What the rig may be that the data cannot fix\n\nThe reported interval adds to the statistical one (bootstrap, curvature, "
+              "drive halves) how far each parameter moves when the final model is refitted with one rig property the data cannot fix "
+              "set to an end of its prior; the largest move per property and side enters in quadrature.\n\n| rig property tried |";
+        std::vector<std::string> names;
+        for (const auto& [name, move] : d.rigUnknowns.front().moves)
+            if (!diag::isNuisance(name)) names.push_back(name);
+        for (const auto& name : names) md << " move of " << name << " |";
+        md << "\n|---|";
+        for (std::size_t k = 0; k < names.size(); ++k) md << "---|";
+        md << "\n";
+        for (const auto& t : d.rigUnknowns) {
+            md << "| " << t.setting << " |";
+            for (const auto& name : names) md << " " << fmt(t.moves.at(name), "%+.3g") << " |";
+            md << "\n";
+        }
         md << "\n";
     }
     const BoundaryFit bm = fitLowerBoundary(measured), bb = fitLowerBoundary(base), bf = fitLowerBoundary(fin);
@@ -343,7 +396,9 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
           "transients are chaotic). Parameter intervals: " << o.parameterBootstrap << " refits on bootstrap resamples of the fit strokes, "
           "each from a fresh start, and a second from the local curvature (Gauss-Newton on the per-stroke errors, Eigen); the reported "
           "interval spans both and the refits on the low- and high-drive halves (a parameter that depends on which strokes it is fitted "
-          "to carries model mismatch the resamples do not show). The floor is the "
+          "to carries model mismatch the resamples do not show), then adds in quadrature, side by side, the moves the rig unknowns "
+          "cause (contact radius 150 and 350 um, torsion at Z_t/Z_0 = 2: the Gauss-Newton move on the signed metric parts) and the "
+          "model discrepancy that a study of reference sets measured (standard deviations:" << discrepancyText(o) << "). The floor is the "
           "final model against itself with 1 % scatter of force and acceleration on the test strokes. "
        << d.simulations << " simulations in " << fmt(d.seconds, "%.1f") << " s.\n";
     for (const auto& w : d.warnings) md << "\nWarning: " << w << "\n";

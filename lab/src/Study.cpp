@@ -74,6 +74,9 @@ struct Scored {
     std::map<std::string, std::array<double, 3>> estimate; ///< value, ci low, ci high
     /// the interval without the drive halves' refits (bootstrap and curvature only), where given
     std::map<std::string, std::array<double, 2>> withoutHalves;
+    /// the statistical interval (bootstrap, curvature, drive halves), and that with the rig
+    /// unknowns' moves added: the reported one less the model discrepancy, where given
+    std::map<std::string, std::array<double, 2>> statistical, withRig;
     std::set<std::string> unidentified; ///< reported as not identified: interval = search range
     std::map<std::string, std::array<double, 3>> calibration; ///< nuisance -> value, ci low, ci high
     std::map<std::string, double> rig;
@@ -281,6 +284,13 @@ std::string scoreStudy(const fs::path& dir)
                         w = {std::min(w[0], v["ci95_curvature"][0].get<double>()), std::max(w[1], v["ci95_curvature"][1].get<double>())};
                     s.withoutHalves[name] = w;
                 }
+                if (v.contains("ci95_statistical")) {
+                    const double x = v["value"].get<double>(), lo = v["ci95_statistical"][0].get<double>(), hi = v["ci95_statistical"][1].get<double>();
+                    s.statistical[name] = {lo, hi};
+                    const double down = v.contains("systematic_moves") ? v["systematic_moves"][0].get<double>() : 0.0;
+                    const double up = v.contains("systematic_moves") ? v["systematic_moves"][1].get<double>() : 0.0;
+                    s.withRig[name] = {x - std::hypot(x - lo, down), x + std::hypot(hi - x, up)};
+                }
             }
         }
         if (d.contains("calibration") && d["calibration"].contains("values"))
@@ -349,7 +359,10 @@ std::string scoreStudy(const fs::path& dir)
         summary["detection"][e] = {{"hidden", hid}, {"named", det}, {"false_positive", fp}, {"not_hidden", other}};
     }
     md << "\n| parameter | named sets | median error | worst error | within the issue's tolerance | truth inside the 95 % interval |\n|---|---|---|---|---|---|\n";
-    int covered = 0, intervals = 0, coveredWithoutHalves = 0;
+    int covered = 0, intervals = 0, coveredWithoutHalves = 0, coveredStatistical = 0, coveredWithRig = 0;
+    // The model discrepancy this study measures: the spread of (found - true) beyond what the
+    // statistical and rig-unknown intervals allow, by moments (relative for r_A and zt_ratio).
+    std::map<std::string, std::pair<double, int>> excess;
     for (const std::string& p : parameterNames()) {
         std::vector<double> err;
         int within = 0, inside = 0, unidentified = 0;
@@ -372,6 +385,16 @@ std::string scoreStudy(const fs::path& dir)
             ++intervals;
             const auto narrow = s.withoutHalves.find(p);
             coveredWithoutHalves += narrow != s.withoutHalves.end() ? t >= narrow->second[0] && t <= narrow->second[1] : in;
+            const auto stat = s.statistical.find(p);
+            coveredStatistical += stat != s.statistical.end() ? t >= stat->second[0] && t <= stat->second[1] : in;
+            const auto rig = s.withRig.find(p);
+            coveredWithRig += rig != s.withRig.end() ? t >= rig->second[0] && t <= rig->second[1] : in;
+            if (rig != s.withRig.end()) {
+                const double unit = discrepancyIsRelative(p) ? std::abs(t) : 1.0;
+                const double sd = (rig->second[1] - rig->second[0]) / (2.0 * 1.96) / unit, miss = (v - t) / unit;
+                excess[p].first += miss * miss - sd * sd;
+                ++excess[p].second;
+            }
         }
         if (err.empty()) {
             md << "| " << p << " | 0 | - | - | - | - |\n";
@@ -388,8 +411,20 @@ std::string scoreStudy(const fs::path& dir)
     }
     md << fmt("\nCoverage of the 95 %% intervals over all named parameters that the data identify: %.0f %%", intervals ? 100.0 * covered / intervals : 0.0)
        << " (" << covered << " of " << intervals << ")"
-       << fmt("; without the drive halves' refits (bootstrap and curvature only): %.0f %%", intervals ? 100.0 * coveredWithoutHalves / intervals : 0.0)
+       << fmt("; statistical part only (bootstrap, curvature, drive halves): %.0f %%", intervals ? 100.0 * coveredStatistical / intervals : 0.0)
+       << " (" << coveredStatistical << fmt("); with the rig unknowns, without the model discrepancy: %.0f %%", intervals ? 100.0 * coveredWithRig / intervals : 0.0)
+       << " (" << coveredWithRig << fmt("); bootstrap and curvature only: %.0f %%", intervals ? 100.0 * coveredWithoutHalves / intervals : 0.0)
        << " (" << coveredWithoutHalves << ").\n";
+    md << "\nModel discrepancy this study measures (standard deviation of found - true beyond the statistical and rig-unknown intervals; "
+          "relative for r_A and zt_ratio; `rosin diagnose --model-discrepancy NAME=SD` takes it):";
+    for (const auto& [p, e] : excess) {
+        const double sd = std::sqrt(std::max(0.0, e.first / e.second));
+        md << " " << p << fmt(" %.3g", sd) << " (" << e.second << " sets);";
+        summary["model_discrepancy"][p] = sd;
+    }
+    md << "\n";
+    summary["coverage_statistical"] = intervals ? static_cast<double>(coveredStatistical) / intervals : 0.0;
+    summary["coverage_with_rig_unknowns"] = intervals ? static_cast<double>(coveredWithRig) / intervals : 0.0;
     summary["coverage"] = intervals ? static_cast<double>(covered) / intervals : 0.0;
     summary["coverage_without_halves"] = intervals ? static_cast<double>(coveredWithoutHalves) / intervals : 0.0;
     // Nuisances: what the rig really was against what the diagnosis calibrated (not findings,

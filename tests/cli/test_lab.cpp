@@ -271,6 +271,9 @@ TEST(RosinCli, BadArgumentsFailClearlyAndWriteNothing)
         {"frobnicate", "frobnicate"},
         {"render --set rod_effusivity=-3" + out, "--set rod_effusivity"},
         {"render --set colour=3" + out, "unknown parameter 'colour'"},
+        {"diagnose some-set --model-discrepancy r_A=-0.1" + out, "--model-discrepancy r_A=-0.1"},
+        {"diagnose some-set --model-discrepancy colour=0.1" + out, "--model-discrepancy colour=0.1"},
+        {"diagnose some-set --model-discrepancy p" + out, "--model-discrepancy p"},
     };
     for (const auto& [args, expected] : cases) {
         const CliRun r = runRosin(args);

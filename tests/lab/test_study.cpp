@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <tuple>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -241,6 +243,60 @@ TEST(Study, TheReportedIntervalSpansBootstrapCurvatureAndDriveHalves)
     EXPECT_EQ(reportedInterval(f, "r_A"), std::make_pair(0.95, 1.08));
 }
 
+// What the rig may be beyond the data's reach, and the model's own error, are independent of the
+// strokes' scatter: each side of the reported interval adds them in quadrature, inside the range.
+TEST(Study, TheReportedIntervalAddsRigUnknownsAndModelDiscrepancyInQuadrature)
+{
+    Finding f;
+    f.parameters["r_A"] = {1.0, 0.97, 1.03};
+    f.systematic["r_A"] = {0.04, 0.0}; // a smaller contact radius would lower r_A only
+    EXPECT_EQ(statisticalInterval(f, "r_A"), std::make_pair(0.97, 1.03));
+    auto [lo, hi] = reportedInterval(f, "r_A");
+    EXPECT_NEAR(lo, 0.95, 1e-12);
+    EXPECT_NEAR(hi, 1.03, 1e-12);
+    f.discrepancy["r_A"] = 0.03;
+    std::tie(lo, hi) = reportedInterval(f, "r_A");
+    EXPECT_NEAR(lo, 1.0 - std::sqrt(0.03 * 0.03 + 0.04 * 0.04 + 0.03 * 0.03), 1e-12);
+    EXPECT_NEAR(hi, 1.0 + std::sqrt(0.03 * 0.03 + 0.03 * 0.03), 1e-12);
+    Finding g; // near the top of the load exponent's search range (1.1)
+    g.parameters["load_exponent"] = {1.05, 1.0, 1.09};
+    g.discrepancy["load_exponent"] = 0.1;
+    EXPECT_EQ(reportedInterval(g, "load_exponent").second, 1.1);
+}
+
+// Coverage is counted three ways (statistical part alone, with the rig unknowns, as reported),
+// and the study measures the model discrepancy that the reported intervals should carry.
+TEST(Study, CountsCoverageByPartAndMeasuresTheModelDiscrepancy)
+{
+    const fs::path dir = freshDir("parts");
+    auto thermal = [](double value, double low, double high, double sLow, double sHigh, double down, double up) {
+        json f = finding("thermal_memory", "r_A", value, low, high);
+        f["parameters"]["r_A"]["ci95_statistical"] = {sLow, sHigh};
+        f["parameters"]["r_A"]["systematic_moves"] = {down, up};
+        return diagnosis(json::array({f}));
+    };
+    const json truth{{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.0}}}};
+    // 0: the statistical part (0.88-0.98) misses; the rig's +0.07 reaches 0.9 + hypot(0.08, 0.07) = 1.006
+    writeSet(dir, 0, truth, thermal(0.9, 0.8, 1.1, 0.88, 0.98, 0.0, 0.07));
+    // 1: covered by the statistical part already
+    writeSet(dir, 1, truth, thermal(1.02, 0.9, 1.14, 0.97, 1.07, 0.01, 0.01));
+    // 2: missed by every part
+    writeSet(dir, 2, truth, thermal(1.2, 1.1, 1.3, 1.15, 1.25, 0.0, 0.0));
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    const json& s = study["summary"];
+    EXPECT_NEAR(s["coverage"].get<double>(), 2.0 / 3.0, 1e-12);
+    EXPECT_NEAR(s["coverage_statistical"].get<double>(), 1.0 / 3.0, 1e-12);
+    EXPECT_NEAR(s["coverage_with_rig_unknowns"].get<double>(), 2.0 / 3.0, 1e-12);
+    // misses of -0.1, +0.02 and +0.2 against standard deviations of (0.02 + hypot(0.08, 0.07)),
+    // 2 hypot(0.05, 0.01) and 0.1, each over 2 x 1.96: sqrt(mean(miss^2 - sd^2)) = 0.1265
+    EXPECT_NEAR(s["model_discrepancy"]["r_A"].get<double>(), 0.1265, 0.0005);
+    EXPECT_NE(md.find("Model discrepancy this study measures"), std::string::npos) << md;
+    EXPECT_NE(md.find("r_A 0.127 (3 sets)"), std::string::npos) << md;
+    fs::remove_all(dir);
+}
+
 // The study counts coverage with the reported intervals and, beside it, with the bootstrap and
 // curvature intervals alone (what was reported before the drive halves widened it).
 TEST(Study, CountsCoverageWithAndWithoutTheDriveHalves)
@@ -264,7 +320,7 @@ TEST(Study, CountsCoverageWithAndWithoutTheDriveHalves)
     std::ifstream(dir / "study.json") >> study;
     EXPECT_NEAR(study["summary"]["coverage"].get<double>(), 2.0 / 3.0, 1e-12);
     EXPECT_NEAR(study["summary"]["coverage_without_halves"].get<double>(), 1.0 / 3.0, 1e-12);
-    EXPECT_NE(md.find("bootstrap and curvature only): 33 % (1)."), std::string::npos) << md;
+    EXPECT_NE(md.find("bootstrap and curvature only: 33 % (1)."), std::string::npos) << md;
     fs::remove_all(dir);
 }
 

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "rosin/lab/Bench.h"
@@ -31,6 +32,7 @@ namespace {
 struct DiagnoseCommand {
     std::string diagSet, diagOut = "diagnosis";
     DiagnoseOptions diagOptions;
+    std::vector<std::string> discrepancy;
 
     CLI::App* add(CLI::App& app)
     {
@@ -45,6 +47,9 @@ struct DiagnoseCommand {
         diagnoseCmd->add_option("--max-evaluations", diagOptions.maxEvaluations, "Model evaluations per candidate fit")->check(CLI::Range(5, 500))->capture_default_str();
         diagnoseCmd->add_option("--naming-threshold", diagOptions.namingThreshold, "Least validation-error fall (share) of a named effect")->check(finiteIn(0, 1))->capture_default_str();
         diagnoseCmd->add_option("--residual-factor", diagOptions.residualFactor, "Final error above this many floors: unexplained residual")->check(finiteIn(1, 100))->capture_default_str();
+        diagnoseCmd->add_option("--model-discrepancy", discrepancy,
+                                "NAME=SD: the model's own error for parameter NAME (r_A relative, others absolute; 0 = none), "
+                                "instead of the study-calibrated default (r_A=0.064, p=0.065)");
         diagnoseCmd->add_flag("!--no-nuisances", diagOptions.fitNuisances, "Do not fit tension, bow position and the bow side's thermal effusivity as calibration");
         diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
         return diagnoseCmd;
@@ -52,6 +57,19 @@ struct DiagnoseCommand {
 
     int run()
     {
+        for (const std::string& item : discrepancy) {
+            const auto eq = item.find('=');
+            const std::string name = item.substr(0, eq);
+            double sd = std::nan("");
+            try {
+                if (eq != std::string::npos) sd = std::stod(item.substr(eq + 1));
+            } catch (const std::exception&) {
+            }
+            static const std::set<std::string> findings{"r_A", "h0", "p", "load_exponent", "shift_k", "zt_ratio"};
+            if (!findings.count(name) || !std::isfinite(sd) || sd < 0.0 || sd > 10.0)
+                throw LabError("--model-discrepancy " + item + ": expected NAME=SD with NAME one of r_A, h0, p, load_exponent, shift_k, zt_ratio and SD from 0 to 10");
+            diagOptions.modelDiscrepancy[name] = sd;
+        }
         if (fs::exists(diagOut)) throw LabError(diagOut + ": already exists (choose a new folder)");
         const MeasurementSet set = readMeasurementSet(diagSet);
         Progress progress("diagnosing", !diagOptions.quiet);

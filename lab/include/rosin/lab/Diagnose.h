@@ -59,8 +59,17 @@ struct DiagnoseOptions {
     double namingThreshold = 0.05;
     double residualFactor = 3.0;    ///< final error above this many times the floor: unexplained residual
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
+    /// The model's own error on rigs it does not describe (their thermal constants, an unnamed
+    /// torsion): the standard deviation that a finding's parameter still misses the truth by
+    /// beyond its statistical and rig-unknown intervals, measured by `rosin study` on reference
+    /// sets (seed 2034; docs/diagnosis-study.md). r_A's is relative, the others absolute; it
+    /// widens the reported interval (in quadrature) and never decides what is named.
+    std::map<std::string, double> modelDiscrepancy{{"r_A", 0.064}, {"p", 0.065}};
     bool quiet = false;
 };
+
+/// True for parameters whose model discrepancy is a share of their value (r_A, zt_ratio).
+bool discrepancyIsRelative(const std::string& parameter);
 
 /// One calibrated quantity (not a physical finding), with a 95 % interval.
 struct CalibrationValue {
@@ -76,15 +85,31 @@ struct Finding {
     /// name -> {low-drive half, high-drive half}: the parameter refitted on each half of the fit
     /// strokes (rule 5), moved with the parameter when later rounds refit it
     std::map<std::string, std::vector<double>> halves;
+    /// name -> {move down, move up}: how far the parameter goes when the final model is refitted
+    /// with each rig unknown that the data cannot fix at its prior's ends (combined in quadrature)
+    std::map<std::string, std::vector<double>> systematic;
+    /// name -> half-width (95 %, parameter units) of the model discrepancy, where one is set
+    std::map<std::string, double> discrepancy;
     /// Parameters the data do not constrain: the local curvature along them is nil, so their
     /// curvature interval is their whole search range and their value says nothing.
     std::set<std::string> unidentified;
     double heldoutBefore = 0, heldoutAfter = 0;            ///< validation error before and after
 };
 
-/// The 95 % interval a finding reports for one of its parameters: the bootstrap refits' interval
-/// widened to the curvature's and to the refits on the two drive halves.
+/// The statistical 95 % interval of a finding's parameter: the bootstrap refits' interval widened
+/// to the curvature's and to the refits on the two drive halves.
+std::pair<double, double> statisticalInterval(const Finding& f, const std::string& name);
+/// The 95 % interval a finding reports: the statistical one with the rig unknowns' moves and the
+/// model discrepancy added in quadrature on each side.
 std::pair<double, double> reportedInterval(const Finding& f, const std::string& name);
+
+/// A rig property the data cannot fix, tried at its prior's ends to size the systematic part of
+/// the findings' intervals.
+struct RigUnknownTrial {
+    std::string unknown;  ///< e.g. contact_radius
+    std::string setting;  ///< what was tried, in words
+    std::map<std::string, double> moves; ///< parameter -> refitted value - final value
+};
 
 /// One candidate extension tried in one round: fitted on the fit strokes, judged on validation.
 struct Trial {
@@ -129,6 +154,7 @@ struct Diagnosis {
     double scale = 1.0;         ///< N per signal unit
     bool triggersDetected = false; ///< gesture starts estimated from pre-slip ramps
     std::vector<CalibrationValue> calibration;
+    std::vector<RigUnknownTrial> rigUnknowns; ///< the systematic part of the findings' intervals
     Residual residual;
     std::vector<std::string> rules; ///< the naming rules and their thresholds, in words
     std::vector<std::string> warnings;
