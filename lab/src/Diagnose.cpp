@@ -425,53 +425,15 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                         if (lo <= bottom && hi >= top) f.unidentified.insert(names[k]);
                     }
             }
-            // The systematic part: what the rig may be that neither the fits nor the metric can
-            // fix. Each such property is set to an end of its prior with the parameters held; the
-            // Gauss-Newton move on the metric's signed parts (first-slip time, pre-slip force, jump,
-            // transient length: simulated - measured, per stroke) that takes up the change is how
-            // far the parameters would go. A refit would say the same where the error surface is
-            // smooth; on this chaotic one it mostly stays where it starts.
+            // The systematic part: what the rig may be that neither the fits nor the metric can fix.
             if (!d.findings.empty()) {
-                say("systematic: signed Jacobian", 0.0);
-                auto signedAt = [&](const EffectModel& base, const Eigen::VectorXd& y) {
-                    EffectModel m = base;
-                    for (std::size_t k = 0; k < names.size(); ++k) m.params[names[k]] = y[static_cast<Eigen::Index>(k)];
-                    return engine.signedResiduals(m, fitSet);
-                };
-                Eigen::MatrixXd signedJ(static_cast<Eigen::Index>(4 * fitSet.size()), x.size());
-                for (Eigen::Index k = 0; k < x.size(); ++k) {
-                    Eigen::VectorXd up = x, down = x;
-                    up[k] += steps[k];
-                    down[k] -= steps[k];
-                    signedJ.col(k) = (signedAt(current, up) - signedAt(current, down)) / (2.0 * steps[k]);
-                }
-                const Eigen::VectorXd atFinal = signedAt(current, x);
-                std::map<std::string, std::map<std::string, std::array<double, 2>>> largest; // parameter -> property -> {down, up}
-                for (const RigUnknown& u : rigUnknowns(current)) {
-                    say("systematic: " + u.setting, 0.0);
-                    EffectModel rig = current;
-                    for (const auto& e : u.adds) rig.effects.push_back(e);
-                    for (const auto& [name, value] : u.params) rig.params[name] = value;
-                    const Eigen::VectorXd move = gaussNewtonShift(signedJ, signedAt(rig, x) - atFinal);
-                    RigUnknownTrial trial{u.name, u.setting, {}};
-                    for (std::size_t k = 0; k < names.size(); ++k) {
-                        const double m = move[static_cast<Eigen::Index>(k)];
-                        trial.moves[names[k]] = m;
-                        auto& side = largest[names[k]][u.name];
-                        side[0] = std::max(side[0], -m);
-                        side[1] = std::max(side[1], m);
-                    }
-                    d.rigUnknowns.push_back(std::move(trial));
-                }
-                // properties are independent: their moves add in quadrature, per side
+                say("systematic: rig unknowns", 0.0);
+                d.rigUnknowns = rigUnknownMoves(engine, current, names, x, steps, fitSet);
+                const auto sides = movesBySide(d.rigUnknowns);
                 for (auto& f : d.findings)
                     for (const auto& [name, v] : f.parameters) {
-                        double down = 0, up = 0;
-                        for (const auto& [property, side] : largest[name]) {
-                            down += side[0] * side[0];
-                            up += side[1] * side[1];
-                        }
-                        f.systematic[name] = {std::sqrt(down), std::sqrt(up)};
+                        const auto side = sides.find(name);
+                        f.systematic[name] = side != sides.end() ? std::vector<double>{side->second[0], side->second[1]} : std::vector<double>{0.0, 0.0};
                     }
             }
         }

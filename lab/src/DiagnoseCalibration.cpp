@@ -59,6 +59,63 @@ Eigen::VectorXd gaussNewtonShift(const Eigen::MatrixXd& J, const Eigen::VectorXd
     return shift;
 }
 
+// Each rig property is set to an end of its prior with the parameters held; the Gauss-Newton move
+// on the metric's signed parts (first-slip time, pre-slip force, jump, transient length: simulated
+// - measured, per stroke) that takes up the change is how far the parameters would go. A refit
+// would say the same where the error surface is smooth; on this chaotic one it mostly stays where
+// it starts.
+std::vector<RigUnknownTrial> rigUnknownMoves(const Engine& engine, const EffectModel& final, const std::vector<std::string>& names,
+                                             const Eigen::VectorXd& x, const Eigen::VectorXd& steps, const std::vector<std::size_t>& on)
+{
+    auto signedAt = [&](const EffectModel& base, const Eigen::VectorXd& y) {
+        EffectModel m = base;
+        for (std::size_t k = 0; k < names.size(); ++k) m.params[names[k]] = y[static_cast<Eigen::Index>(k)];
+        return engine.signedResiduals(m, on);
+    };
+    Eigen::MatrixXd J(static_cast<Eigen::Index>(4 * on.size()), x.size());
+    for (Eigen::Index k = 0; k < x.size(); ++k) {
+        Eigen::VectorXd up = x, down = x;
+        up[k] += steps[k];
+        down[k] -= steps[k];
+        J.col(k) = (signedAt(final, up) - signedAt(final, down)) / (2.0 * steps[k]);
+    }
+    const Eigen::VectorXd atFinal = signedAt(final, x);
+    std::vector<RigUnknownTrial> trials;
+    for (const RigUnknown& u : rigUnknowns(final)) {
+        EffectModel rig = final;
+        for (const auto& e : u.adds) rig.effects.push_back(e);
+        for (const auto& [name, value] : u.params) rig.params[name] = value;
+        const Eigen::VectorXd move = gaussNewtonShift(J, signedAt(rig, x) - atFinal);
+        RigUnknownTrial trial{u.name, u.setting, {}};
+        for (std::size_t k = 0; k < names.size(); ++k) trial.moves[names[k]] = move[static_cast<Eigen::Index>(k)];
+        trials.push_back(std::move(trial));
+    }
+    return trials;
+}
+
+std::map<std::string, std::array<double, 2>> movesBySide(const std::vector<RigUnknownTrial>& trials)
+{
+    // the largest move per property and side (a property's two ends may move a parameter the same way)
+    std::map<std::string, std::map<std::string, std::array<double, 2>>> largest; // parameter -> property -> {down, up}
+    for (const auto& t : trials)
+        for (const auto& [name, m] : t.moves) {
+            auto& side = largest[name][t.unknown];
+            side[0] = std::max(side[0], -m);
+            side[1] = std::max(side[1], m);
+        }
+    // properties are independent: their moves add in quadrature, per side
+    std::map<std::string, std::array<double, 2>> out;
+    for (const auto& [name, byProperty] : largest) {
+        double down = 0, up = 0;
+        for (const auto& [property, side] : byProperty) {
+            down += side[0] * side[0];
+            up += side[1] * side[1];
+        }
+        out[name] = {std::sqrt(down), std::sqrt(up)};
+    }
+    return out;
+}
+
 SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts)
 {
     auto curve = [](const Eigen::VectorXd& q) {

@@ -60,17 +60,28 @@ StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, cons
     return r;
 }
 
-ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info)
+namespace {
+/// Simulated - measured for the metric's first four parts, each in its own unit (share of the
+/// measured first-slip time, of the bow force, of 25 periods; a transient that never settles
+/// counts as 30 periods). Both strokes must slip.
+std::array<double, 4> scaledDifferences(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g)
 {
     const double F = g.force;
+    const double nm = m.transientPeriods < 0 ? 30 : m.transientPeriods, ns = s.transientPeriods < 0 ? 30 : s.transientPeriods;
+    return {(s.firstSlip - m.firstSlip) / m.firstSlip, (s.forceBeforeSlip - m.forceBeforeSlip) / F, (s.firstDrop - m.firstDrop) / F, (ns - nm) / 25.0};
+}
+} // namespace
+
+ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info)
+{
     ErrorParts e;
     if (m.firstSlip < 0 && s.firstSlip < 0) return e;
     if (m.firstSlip < 0 || s.firstSlip < 0) return {1, 1, 1, 1, 1};
-    e.firstSlip = std::min(1.0, std::abs(s.firstSlip - m.firstSlip) / m.firstSlip);
-    e.forceBeforeSlip = std::min(1.0, std::abs(s.forceBeforeSlip - m.forceBeforeSlip) / F);
-    e.jump = std::min(1.0, std::abs(s.firstDrop - m.firstDrop) / F);
-    const double nm = m.transientPeriods < 0 ? 30 : m.transientPeriods, ns = s.transientPeriods < 0 ? 30 : s.transientPeriods;
-    e.transient = std::min(1.0, std::abs(nm - ns) / 25.0);
+    const auto d = scaledDifferences(m, s, g);
+    e.firstSlip = std::min(1.0, std::abs(d[0]));
+    e.forceBeforeSlip = std::min(1.0, std::abs(d[1]));
+    e.jump = std::min(1.0, std::abs(d[2]));
+    e.transient = std::min(1.0, std::abs(d[3]));
     const std::size_t n = std::min(m.wave.size(), s.wave.size());
     if (n > 0) {
         double acc = 0;
@@ -84,10 +95,9 @@ ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gestu
 std::array<double, 4> signedParts(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g)
 {
     if (m.firstSlip < 0 || s.firstSlip < 0) return {0, 0, 0, 0};
-    const double F = g.force;
-    const double nm = m.transientPeriods < 0 ? 30 : m.transientPeriods, ns = s.transientPeriods < 0 ? 30 : s.transientPeriods;
-    return {0.25 * (s.firstSlip - m.firstSlip) / m.firstSlip, 0.25 * (s.forceBeforeSlip - m.forceBeforeSlip) / F,
-            0.25 * (s.firstDrop - m.firstDrop) / F, 0.10 * (ns - nm) / 25.0};
+    auto d = scaledDifferences(m, s, g);
+    for (std::size_t k = 0; k < d.size(); ++k) d[k] *= ErrorParts::kWeights[k];
+    return d;
 }
 
 double mean(const std::vector<ErrorParts>& e)

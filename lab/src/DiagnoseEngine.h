@@ -77,7 +77,7 @@ bool isNuisance(const std::string& p);
 std::string nuisanceMeaning(const std::string& p);
 
 /// A rig property that neither the fits nor the metric can fix, set to one end of its prior:
-/// the model gets `adds` and the fixed `params` (not fitted), and the final model is refitted.
+/// the model gets `adds` and the fixed `params` (not fitted).
 struct RigUnknown {
     std::string name;
     std::string setting;
@@ -141,6 +141,12 @@ Eigen::MatrixXd curvatureCovariance(const std::function<Eigen::VectorXd(const Ei
 /// The Gauss-Newton move of the parameters that takes up a change dr of the residuals, given their
 /// Jacobian (directions without curvature do not move).
 Eigen::VectorXd gaussNewtonShift(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& dr);
+/// How far each rig unknown that matters to the final model would move its parameters `names`
+/// (at x; central differences with `steps` on the strokes `on`).
+std::vector<RigUnknownTrial> rigUnknownMoves(const Engine& engine, const EffectModel& final, const std::vector<std::string>& names,
+                                             const Eigen::VectorXd& x, const Eigen::VectorXd& steps, const std::vector<std::size_t>& on);
+/// parameter -> {move down, move up}: the largest move per property and side, properties in quadrature.
+std::map<std::string, std::array<double, 2>> movesBySide(const std::vector<RigUnknownTrial>& trials);
 
 /// The rig's steady-sliding curve from its steady_sliding.csv: the SW00 shape with four factors
 /// (level, the two speed scales, the high-speed floor) by Levenberg-Marquardt on relative residuals.

@@ -137,7 +137,7 @@ std::string describe(const std::string& effect, const std::vector<ErrorParts>& b
     // The part of the comparison the extension mended most, weighted as in the metric.
     const char* names[] = {"first-slip times", "bridge forces before the first slip", "first-slip jumps", "transient lengths",
                            "waveforms just after the first slip"};
-    const double weights[] = {0.25, 0.25, 0.25, 0.10, 0.15};
+    const auto& weights = ErrorParts::kWeights;
     double b[5] = {0, 0, 0, 0, 0}, a[5] = {0, 0, 0, 0, 0};
     for (std::size_t i = 0; i < before.size(); ++i) {
         const double pb[] = {before[i].firstSlip, before[i].forceBeforeSlip, before[i].jump, before[i].transient, before[i].waveform};
@@ -166,8 +166,6 @@ std::string describe(const std::string& effect, const std::vector<ErrorParts>& b
 
 } // namespace diag
 
-// Where the model misses part of the physics, a parameter depends on which strokes it is fitted
-// to, and resampling all of them does not show that: the drive halves' refits widen the interval.
 namespace {
 std::string discrepancyText(const DiagnoseOptions& o)
 {
@@ -180,6 +178,8 @@ std::string discrepancyText(const DiagnoseOptions& o)
 }
 } // namespace
 
+// Where the model misses part of the physics, a parameter depends on which strokes it is fitted
+// to, and resampling all of them does not show that: the drive halves' refits widen the interval.
 std::pair<double, double> statisticalInterval(const Finding& f, const std::string& name)
 {
     const std::vector<double>& v = f.parameters.at(name);
@@ -196,18 +196,20 @@ std::pair<double, double> statisticalInterval(const Finding& f, const std::strin
 // What the rig may be beyond the data's reach moves a parameter as surely as the strokes'
 // scatter does; the two are independent, so their half-widths add in quadrature. The interval
 // stays inside the search range, like every fit.
+std::pair<double, double> widenedInQuadrature(double value, std::pair<double, double> interval, double down, double up)
+{
+    return {value - std::hypot(value - interval.first, down), value + std::hypot(interval.second - value, up)};
+}
+
 std::pair<double, double> reportedInterval(const Finding& f, const std::string& name)
 {
-    auto [lo, hi] = statisticalInterval(f, name);
     const auto s = f.systematic.find(name);
     const auto m = f.discrepancy.find(name);
     const double down = s != f.systematic.end() ? s->second[0] : 0.0, up = s != f.systematic.end() ? s->second[1] : 0.0;
     const double model = m != f.discrepancy.end() ? m->second : 0.0;
-    const double v = f.parameters.at(name)[0];
+    const auto [lo, hi] = widenedInQuadrature(f.parameters.at(name)[0], statisticalInterval(f, name), std::hypot(down, model), std::hypot(up, model));
     const auto [bottom, top] = diag::parameterBounds().at(name);
-    lo = std::max(bottom, v - std::sqrt((v - lo) * (v - lo) + down * down + model * model));
-    hi = std::min(top, v + std::sqrt((hi - v) * (hi - v) + up * up + model * model));
-    return {lo, hi};
+    return {std::max(bottom, lo), std::min(top, hi)};
 }
 
 void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptions& o)

@@ -32,7 +32,7 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
         r.ratio = r.error / r.floor;
         r.present = r.ratio > o.residualFactor;
         const char* names[] = {"first-slip time", "bridge force before the first slip", "first-slip jump", "transient length", "waveform after the first slip"};
-        const double w[] = {0.25, 0.25, 0.25, 0.10, 0.15};
+        const auto& w = ErrorParts::kWeights;
         double partErr[5] = {0, 0, 0, 0, 0}, partFloor[5] = {0, 0, 0, 0, 0};
         for (std::size_t k = 0; k < testSet.size(); ++k) {
             const ErrorParts& e = currentTest[k];

@@ -289,7 +289,8 @@ std::string scoreStudy(const fs::path& dir)
                     s.statistical[name] = {lo, hi};
                     const double down = v.contains("systematic_moves") ? v["systematic_moves"][0].get<double>() : 0.0;
                     const double up = v.contains("systematic_moves") ? v["systematic_moves"][1].get<double>() : 0.0;
-                    s.withRig[name] = {x - std::hypot(x - lo, down), x + std::hypot(hi - x, up)};
+                    const auto [rigLo, rigHi] = widenedInQuadrature(x, {lo, hi}, down, up);
+                    s.withRig[name] = {rigLo, rigHi};
                 }
             }
         }

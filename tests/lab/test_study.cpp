@@ -43,6 +43,14 @@ json finding(const std::string& effect, const std::string& parameter, double val
 }
 
 json diagnosis(const json& findings) { return {{"findings", findings}, {"gain", {{"baseline", 0.3}, {"final", 0.08}}}}; }
+
+/// A diagnosis naming thermal memory with r_A at value [low, high] and the further interval fields given.
+json thermalDiagnosis(double value, double low, double high, const json& fields)
+{
+    json f = finding("thermal_memory", "r_A", value, low, high);
+    f["parameters"]["r_A"].update(fields);
+    return diagnosis(json::array({f}));
+}
 } // namespace
 
 TEST(Study, PlanHasTheAskedNullsAndMixOfSinglesDoublesAndTriples)
@@ -270,10 +278,7 @@ TEST(Study, CountsCoverageByPartAndMeasuresTheModelDiscrepancy)
 {
     const fs::path dir = freshDir("parts");
     auto thermal = [](double value, double low, double high, double sLow, double sHigh, double down, double up) {
-        json f = finding("thermal_memory", "r_A", value, low, high);
-        f["parameters"]["r_A"]["ci95_statistical"] = {sLow, sHigh};
-        f["parameters"]["r_A"]["systematic_moves"] = {down, up};
-        return diagnosis(json::array({f}));
+        return thermalDiagnosis(value, low, high, {{"ci95_statistical", {sLow, sHigh}}, {"systematic_moves", {down, up}}});
     };
     const json truth{{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.0}}}};
     // 0: the statistical part (0.88-0.98) misses; the rig's +0.07 reaches 0.9 + hypot(0.08, 0.07) = 1.006
@@ -303,10 +308,7 @@ TEST(Study, CountsCoverageWithAndWithoutTheDriveHalves)
 {
     const fs::path dir = freshDir("halves");
     auto thermal = [](double value, double low, double high, double bLow, double bHigh, double cLow, double cHigh) {
-        json f = finding("thermal_memory", "r_A", value, low, high);
-        f["parameters"]["r_A"]["ci95_bootstrap"] = {bLow, bHigh};
-        f["parameters"]["r_A"]["ci95_curvature"] = {cLow, cHigh};
-        return diagnosis(json::array({f}));
+        return thermalDiagnosis(value, low, high, {{"ci95_bootstrap", {bLow, bHigh}}, {"ci95_curvature", {cLow, cHigh}}});
     };
     const json truth{{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.1}}}};
     // Covered only thanks to the halves (bootstrap and curvature stop at 1.05).

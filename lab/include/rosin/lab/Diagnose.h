@@ -43,7 +43,12 @@ struct StrokeFeatures {
 /// dependence), so they weigh less: otherwise their scatter hides real effects.
 struct ErrorParts {
     double firstSlip = 0, forceBeforeSlip = 0, jump = 0, transient = 0, waveform = 0;
-    double total() const { return 0.25 * firstSlip + 0.25 * forceBeforeSlip + 0.25 * jump + 0.10 * transient + 0.15 * waveform; }
+    /// the parts' weights in the metric, in the order above
+    static constexpr double kWeights[5] = {0.25, 0.25, 0.25, 0.10, 0.15};
+    double total() const
+    {
+        return kWeights[0] * firstSlip + kWeights[1] * forceBeforeSlip + kWeights[2] * jump + kWeights[3] * transient + kWeights[4] * waveform;
+    }
 };
 
 struct DiagnoseOptions {
@@ -85,8 +90,8 @@ struct Finding {
     /// name -> {low-drive half, high-drive half}: the parameter refitted on each half of the fit
     /// strokes (rule 5), moved with the parameter when later rounds refit it
     std::map<std::string, std::vector<double>> halves;
-    /// name -> {move down, move up}: how far the parameter goes when the final model is refitted
-    /// with each rig unknown that the data cannot fix at its prior's ends (combined in quadrature)
+    /// name -> {move down, move up}: how far the parameter would go with each rig unknown that
+    /// the data cannot fix at its prior's ends (Gauss-Newton moves, properties in quadrature)
     std::map<std::string, std::vector<double>> systematic;
     /// name -> half-width (95 %, parameter units) of the model discrepancy, where one is set
     std::map<std::string, double> discrepancy;
@@ -102,13 +107,15 @@ std::pair<double, double> statisticalInterval(const Finding& f, const std::strin
 /// The 95 % interval a finding reports: the statistical one with the rig unknowns' moves and the
 /// model discrepancy added in quadrature on each side.
 std::pair<double, double> reportedInterval(const Finding& f, const std::string& name);
+/// [lo, hi] around value with further half-widths added in quadrature below (down) and above (up).
+std::pair<double, double> widenedInQuadrature(double value, std::pair<double, double> interval, double down, double up);
 
 /// A rig property the data cannot fix, tried at its prior's ends to size the systematic part of
 /// the findings' intervals.
 struct RigUnknownTrial {
     std::string unknown;  ///< e.g. contact_radius
     std::string setting;  ///< what was tried, in words
-    std::map<std::string, double> moves; ///< parameter -> refitted value - final value
+    std::map<std::string, double> moves; ///< parameter -> its Gauss-Newton move from the final value
 };
 
 /// One candidate extension tried in one round: fitted on the fit strokes, judged on validation.
