@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
-#include <set>
 #include <nlohmann/json.hpp>
 
 #include "rosin/lab/Bench.h"
@@ -65,8 +64,7 @@ struct DiagnoseCommand {
                 if (eq != std::string::npos) sd = std::stod(item.substr(eq + 1));
             } catch (const std::exception&) {
             }
-            static const std::set<std::string> findings{"r_A", "h0", "p", "load_exponent", "shift_k", "zt_ratio"};
-            if (!findings.count(name) || !std::isfinite(sd) || sd < 0.0 || sd > 10.0)
+            if (effectOfParameter(name) == "calibration" || !std::isfinite(sd) || sd < 0.0 || sd > 10.0) // not a finding's parameter
                 throw LabError("--model-discrepancy " + item + ": expected NAME=SD with NAME one of r_A, h0, p, load_exponent, shift_k, zt_ratio and SD from 0 to 10");
             diagOptions.modelDiscrepancy[name] = sd;
         }
