@@ -171,19 +171,28 @@ void RosinProcessor::housekeeping()
     map_.collect();
     // Host parameters that a learned controller or a keyswitch moved: the latest value of each,
     // so the slider, automation, the saved session and the views agree with what plays.
+    // A move made on a state that has since been restored over is dropped: the restore is newer.
     std::array<float, paramCount> latest{};
-    std::array<int, paramCount> count{};
-    HostChange c;
-    while (toHost_.pop(c))
-        if (c.param >= 0 && c.param < paramCount) {
-            latest[static_cast<std::size_t>(c.param)] = c.value;
-            ++count[static_cast<std::size_t>(c.param)];
-        }
-    for (int i = 0; i < paramCount; ++i)
-        if (count[static_cast<std::size_t>(i)] > 0) {
-            setPhysical(static_cast<Param>(i), latest[static_cast<std::size_t>(i)]);
-            inFlight_[static_cast<std::size_t>(i)].fetch_sub(count[static_cast<std::size_t>(i)], std::memory_order_release);
-        }
+    std::array<int, paramCount> count{}, stale{};
+    {
+        const std::lock_guard<std::mutex> lock(hostChangeMutex_);
+        const std::uint32_t generation = stateGeneration_.load(std::memory_order_acquire);
+        HostChange c;
+        while (toHost_.pop(c))
+            if (c.param >= 0 && c.param < paramCount) {
+                const auto i = static_cast<std::size_t>(c.param);
+                if (c.generation != generation) {
+                    ++stale[i];
+                    continue;
+                }
+                latest[i] = c.value;
+                ++count[i];
+            }
+        for (int i = 0; i < paramCount; ++i)
+            if (count[static_cast<std::size_t>(i)] > 0) setPhysical(static_cast<Param>(i), latest[static_cast<std::size_t>(i)]);
+    }
+    for (std::size_t i = 0; i < count.size(); ++i)
+        if (count[i] + stale[i] > 0) inFlight_[i].fetch_sub(count[i] + stale[i], std::memory_order_release);
     Learn l;
     while (learned_.pop(l)) {
         const auto& info = paramInfo(l.param);
@@ -293,6 +302,11 @@ void RosinProcessor::pushParameters(engine::Synth& synth, bool all) noexcept
     }
 }
 
+float RosinProcessor::engineParameter(Param p) const noexcept
+{
+    return current_ != nullptr ? current_->parameter(static_cast<int>(p)) : std::numeric_limits<float>::quiet_NaN();
+}
+
 void RosinProcessor::addEvent(const ControlEvent& e) noexcept
 {
     if (eventCount_ >= maxBlockEvents) {
@@ -375,7 +389,7 @@ void RosinProcessor::handle(engine::Synth& synth, const ControlEvent& e) noexcep
         // The host parameter follows (the housekeeping thread moves it); until then the
         // parameter push leaves the engine's value alone.
         inFlight_[static_cast<std::size_t>(e.index)].fetch_add(1, std::memory_order_acq_rel);
-        if (!toHost_.push({e.index, synth.parameter(e.index)})) inFlight_[static_cast<std::size_t>(e.index)].fetch_sub(1, std::memory_order_acq_rel);
+        if (!toHost_.push({e.index, synth.parameter(e.index), stateGeneration_.load(std::memory_order_acquire)})) inFlight_[static_cast<std::size_t>(e.index)].fetch_sub(1, std::memory_order_acq_rel);
     }
 }
 
@@ -424,7 +438,9 @@ void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBu
         for (int k = 0; k < eventCount_; ++k) performance_.apply(events_[static_cast<std::size_t>(k)]);
         buffer.clear();
     } else {
-        pushParameters(*current_, false);
+        // After a restore every parameter goes to the engine, also one whose value equals the last
+        // pushed one while a controller had moved the engine away from it.
+        pushParameters(*current_, restored_.exchange(false, std::memory_order_acq_rel));
         int pos = 0;
         for (int k = 0; k < eventCount_;) {
             const int at = std::min(n, events_[static_cast<std::size_t>(k)].frame);

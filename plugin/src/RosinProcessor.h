@@ -92,6 +92,8 @@ public:
     /// [audio thread, or a test between blocks] What the player holds, and the MIDI decoder.
     const engine::Performance& performance() const noexcept { return performance_; }
     const engine::MidiDecoder& decoder() const noexcept { return decoder_; }
+    /// [audio thread, or a test between blocks] A parameter as the playing engine has it (engine units).
+    float engineParameter(engine::Param p) const noexcept;
 
     /// The live views' channel: the audio thread writes frames of the newest note while the
     /// editor listens (ViewRing::setListening); the editor's timer reads them.
@@ -104,7 +106,8 @@ private:
     class Loader;
     struct HostChange {
         int param = -1;
-        float value = 0.0f; ///< engine units
+        float value = 0.0f;            ///< engine units
+        std::uint32_t generation = 0;  ///< the state it was made on (stateGeneration_)
     };
     struct Learn {
         int cc = -1, param = -1;
@@ -161,6 +164,11 @@ private:
     rt::SpscQueue<HostChange, 1024> toHost_;        ///< audio -> housekeeping
     rt::SpscQueue<Learn, 64> learned_;              ///< audio -> housekeeping
     std::array<std::atomic<int>, engine::paramCount> inFlight_{}; ///< host changes queued, not yet made
+    /// One more for every restored state: a controller move made before a restore must not
+    /// land on the host parameter after it (the housekeeping thread drops it).
+    std::atomic<std::uint32_t> stateGeneration_{0};
+    std::atomic<bool> restored_{false}; ///< the next block pushes every parameter to the engine
+    std::mutex hostChangeMutex_; ///< [not audio] a restore and the moving of host parameters, one at a time
     std::atomic<double> sampleRate_{0.0};
     std::atomic<int> requestedInstrument_{-1}; ///< [loader] the instrument it last started to build
     std::atomic<int> settledInstrument_{-1};   ///< the instrument whose build finished (an engine, or a failure)

@@ -126,7 +126,14 @@ void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
     }
     for (const auto& m : loaded.hidMappings) hid_->setMapping(m);
     const int before = juce::roundToInt(instrumentRaw_->load());
-    state_.replaceState(juce::ValueTree::fromXml(*loaded.tree));
+    {
+        // Controller moves still on their way to the host parameters belong to the state being
+        // replaced: they are dropped, and the engine takes every restored value at the next block.
+        const std::lock_guard<std::mutex> lock(hostChangeMutex_);
+        stateGeneration_.fetch_add(1, std::memory_order_acq_rel);
+        state_.replaceState(juce::ValueTree::fromXml(*loaded.tree));
+        restored_.store(true, std::memory_order_release);
+    }
     map_.assign(loaded.mappings);
     {
         const std::lock_guard<std::mutex> lock(loadMutex_);

@@ -331,6 +331,43 @@ TEST(ProcessorSwap, RestoringTheSameInstrumentKeepsItsEngine)
     EXPECT_EQ(p.enginesInstalled(), before);
 }
 
+// A learned controller moves the engine at once and its host parameter a few ms later (the
+// housekeeping thread). A state restored in between is newer than that move: the move must not
+// land on top of it, and the engine must take the restored value even when it equals the value
+// the engine had before the controller moved it (the validator's mid-note restore was sometimes
+// left with a walked force and articulation, and a silent note, before this).
+TEST(ProcessorState, AControllerMoveMadeBeforeARestoreDoesNotOverwriteIt)
+{
+    juce::ScopedJuceInitialiser_GUI juce;
+    RosinProcessor p;
+    p.setPlayConfigDetails(0, 2, 48000.0, 256);
+    p.prepareToPlay(48000.0, 256);
+    const auto force = engine::Param::BowForce;
+    const auto& info = engine::paramInfo(force);
+    p.controllerMap().set(21, static_cast<int>(force), info.min, info.max, false);
+    blocks(p, 4, messages({juce::MidiMessage::noteOn(1, 50, 0.8f)}));
+    juce::MemoryBlock saved;
+    p.getStateInformation(saved);
+    const float restored = p.currentParams()[static_cast<std::size_t>(force)];
+    const float moved = info.min + (info.max - info.min) * 10.0f / 127.0f;
+    ASSERT_GT(std::abs(moved - restored), 0.1f * (info.max - info.min));
+    for (int trial = 0; trial < 5; ++trial) {
+        blocks(p, 1, messages({juce::MidiMessage::controllerEvent(1, 21, 10)}));
+        ASSERT_NEAR(p.engineParameter(force), moved, 1e-4f); // the engine moved within the block
+        p.setStateInformation(saved.getData(), static_cast<int>(saved.getSize()));
+        std::this_thread::sleep_for(std::chrono::milliseconds(60)); // the housekeeping thread runs about ten times
+        blocks(p, 2);
+        EXPECT_NEAR(p.currentParams()[static_cast<std::size_t>(force)], restored, 1e-4f) << "trial " << trial;
+        EXPECT_NEAR(p.engineParameter(force), restored, 1e-4f) << "trial " << trial;
+    }
+    // A move made after the restore still reaches the host parameter.
+    blocks(p, 1, messages({juce::MidiMessage::controllerEvent(1, 21, 10)}));
+    for (int i = 0; i < 200 && std::abs(p.currentParams()[static_cast<std::size_t>(force)] - moved) > 1e-4f; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_NEAR(p.currentParams()[static_cast<std::size_t>(force)], moved, 1e-4f);
+    EXPECT_NEAR(p.engineParameter(force), moved, 1e-4f);
+}
+
 TEST(ProcessorSwap, ABrokenPresetDoesNotStallOfflineRendering)
 {
     // A user folder holds a broken violin preset: the build fails, and an offline render must
