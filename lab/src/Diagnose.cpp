@@ -36,14 +36,33 @@ std::string EffectModel::name() const
     return n;
 }
 
+namespace {
+/// The one table of physical parameters and the effect each belongs to.
+const std::vector<std::pair<std::string, std::string>>& physicalParameters()
+{
+    static const std::vector<std::pair<std::string, std::string>> table{
+        {"r_A", "thermal_memory"},         {"h0", "rate_dependence"},
+        {"p", "rate_dependence"},          {"load_exponent", "hertzian_contact"},
+        {"shift_k", "rosin_temperature_shift"}, {"zt_ratio", "torsional_compliance"}};
+    return table;
+}
+} // namespace
+
 std::string effectOfParameter(const std::string& parameter)
 {
-    if (parameter == "r_A") return "thermal_memory";
-    if (parameter == "h0" || parameter == "p") return "rate_dependence";
-    if (parameter == "load_exponent") return "hertzian_contact";
-    if (parameter == "shift_k") return "rosin_temperature_shift";
-    if (parameter == "zt_ratio") return "torsional_compliance";
+    for (const auto& [name, effect] : physicalParameters())
+        if (name == parameter) return effect;
     return "calibration";
+}
+
+const std::vector<std::string>& physicalParameterNames()
+{
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> n;
+        for (const auto& entry : physicalParameters()) n.push_back(entry.first);
+        return n;
+    }();
+    return names;
 }
 
 using namespace diag;

@@ -28,12 +28,6 @@ namespace {
 
 bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
 
-const std::vector<std::string>& parameterNames()
-{
-    static const std::vector<std::string> p{"r_A", "h0", "p", "load_exponent", "shift_k", "zt_ratio"};
-    return p;
-}
-
 /// How far an effect is from its own absence, for detection against size (thermal memory has
 /// no such value: the thermal law is a different law, not a parameter's end).
 double effectSize(const std::string& effect, const std::map<std::string, double>& truth)
@@ -364,7 +358,7 @@ std::string scoreStudy(const fs::path& dir)
     // The model discrepancy this study measures: the spread of (found - true) beyond what the
     // statistical and rig-unknown intervals allow, by moments (relative for r_A and zt_ratio).
     std::map<std::string, std::pair<double, int>> excess;
-    for (const std::string& p : parameterNames()) {
+    for (const std::string& p : physicalParameterNames()) {
         std::vector<double> err;
         int within = 0, inside = 0, unidentified = 0;
         const Tolerance tol = tolerances().at(p);
@@ -469,7 +463,7 @@ std::string scoreStudy(const fs::path& dir)
     // Per set.
     std::ofstream csv(dir / "study.csv");
     csv << "set,seed,hidden,found,exact,baseline_error,final_error,unexplained";
-    for (const auto& p : parameterNames()) csv << "," << p << "_true," << p << "_found," << p << "_ci_low," << p << "_ci_high";
+    for (const auto& p : physicalParameterNames()) csv << "," << p << "_true," << p << "_found," << p << "_ci_low," << p << "_ci_high";
     const std::vector<std::string> rigCols{"noise_n", "inharmonicity", "bridge_z0y", "headroom", "tension_error", "beta_error", "mu_level", "rod_effusivity"};
     for (const auto& r : rigCols) csv << "," << r;
     csv << "\n";
@@ -481,7 +475,7 @@ std::string scoreStudy(const fs::path& dir)
         std::sort(f.begin(), f.end());
         csv << s.index << "," << s.seed << "," << joined(s.hidden) << "," << joined(s.found) << "," << (h == f) << "," << s.baseline << ","
             << s.final << "," << s.unexplained;
-        for (const auto& p : parameterNames()) {
+        for (const auto& p : physicalParameterNames()) {
             csv << "," << (s.truth.count(p) ? fmt("%.6g", s.truth.at(p)) : "");
             for (int k = 0; k < 3; ++k) csv << "," << (s.estimate.count(p) ? fmt("%.6g", s.estimate.at(p)[static_cast<std::size_t>(k)]) : "");
         }

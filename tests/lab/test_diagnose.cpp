@@ -141,6 +141,25 @@ TEST(DiagnoseSystematic, TheGaussNewtonMoveUndoesALinearChangeAndLeavesFlatDirec
     EXPECT_LT(diag::gaussNewtonShift(J, orthogonal).norm(), 1e-12);
 }
 
+// The one parameter table: each physical parameter belongs to a finding, each nuisance to the
+// calibration, and no name is both (the study's columns and the findings read the same table).
+TEST(DiagnoseParameters, PhysicalParametersBelongToFindingsAndNuisancesToTheCalibration)
+{
+    const auto& names = physicalParameterNames();
+    ASSERT_EQ(names.size(), 6u);
+    std::set<std::string> effects;
+    for (const auto& n : names) {
+        EXPECT_NE(effectOfParameter(n), "calibration") << n;
+        effects.insert(effectOfParameter(n));
+    }
+    EXPECT_EQ(effects, (std::set<std::string>{"thermal_memory", "rate_dependence", "hertzian_contact", "rosin_temperature_shift", "torsional_compliance"}));
+    ASSERT_FALSE(diag::nuisances().empty());
+    for (const auto& k : diag::nuisances()) {
+        EXPECT_EQ(effectOfParameter(k.name), "calibration") << k.name;
+        EXPECT_EQ(std::count(names.begin(), names.end(), k.name), 0) << k.name;
+    }
+}
+
 TEST(DiagnoseConsistency, ReportsNoneWhenTheBaselineMadeTheData) { check({{}, 21}); }
 
 TEST(DiagnoseConsistency, FindsHertzianContactAtAnotherRateWithAnotherReflectionDesign) { check({{"hertzian_contact"}, 27, 44100, true}); }

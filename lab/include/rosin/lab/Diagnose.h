@@ -26,6 +26,8 @@ struct EffectModel {
 /// The effect a model parameter belongs to (r_A: thermal_memory, load_exponent: hertzian_contact,
 /// ...); "calibration" for anything else (the nuisances).
 std::string effectOfParameter(const std::string& parameter);
+/// Every physical parameter a finding can carry, in the order reports and the study list them.
+const std::vector<std::string>& physicalParameterNames();
 
 /// What is compared per stroke (PHYSICS.md 7.1), from a bridge force in newtons that starts
 /// at the gesture start, sampled at the diagnosis rate.
