@@ -440,7 +440,9 @@ void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBu
     } else {
         // After a restore every parameter goes to the engine, also one whose value equals the last
         // pushed one while a controller had moved the engine away from it.
-        pushParameters(*current_, restored_.exchange(false, std::memory_order_acq_rel));
+        const std::uint32_t generation = stateGeneration_.load(std::memory_order_acquire);
+        pushParameters(*current_, generation != pushedGeneration_);
+        pushedGeneration_ = generation;
         int pos = 0;
         for (int k = 0; k < eventCount_;) {
             const int at = std::min(n, events_[static_cast<std::size_t>(k)].frame);

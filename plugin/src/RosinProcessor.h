@@ -147,6 +147,7 @@ private:
     engine::Performance performance_;
     engine::MidiDecoder decoder_;
     int installedInstrument_ = -1;
+    std::uint32_t pushedGeneration_ = 0;     ///< the state generation the engine last took every parameter of
     double lastBlockStart_ = -1.0;           ///< steady-clock seconds: HID events are placed against it
     static constexpr int maxBlockEvents = 4096;
     std::array<engine::ControlEvent, maxBlockEvents> events_{};
@@ -167,7 +168,6 @@ private:
     /// One more for every restored state: a controller move made before a restore must not
     /// land on the host parameter after it (the housekeeping thread drops it).
     std::atomic<std::uint32_t> stateGeneration_{0};
-    std::atomic<bool> restored_{false}; ///< the next block pushes every parameter to the engine
     std::mutex hostChangeMutex_; ///< [not audio] a restore and the moving of host parameters, one at a time
     std::atomic<double> sampleRate_{0.0};
     std::atomic<int> requestedInstrument_{-1}; ///< [loader] the instrument it last started to build

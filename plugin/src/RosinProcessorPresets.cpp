@@ -130,9 +130,8 @@ void RosinProcessor::setStateInformation(const void* data, int sizeInBytes)
         // Controller moves still on their way to the host parameters belong to the state being
         // replaced: they are dropped, and the engine takes every restored value at the next block.
         const std::lock_guard<std::mutex> lock(hostChangeMutex_);
-        stateGeneration_.fetch_add(1, std::memory_order_acq_rel);
         state_.replaceState(juce::ValueTree::fromXml(*loaded.tree));
-        restored_.store(true, std::memory_order_release);
+        stateGeneration_.fetch_add(1, std::memory_order_acq_rel);
     }
     map_.assign(loaded.mappings);
     {
