@@ -138,7 +138,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         d.warnings.push_back(set.steady.empty() ? "no steady_sliding.csv: the reference SW00 curve is assumed for this rosin"
                                                 : "steady_sliding.csv has fewer than 5 rows: the reference SW00 curve is assumed");
     }
-    Engine engine(strokes, info, o.simRate, steady);
+    Engine engine(strokes, info, o.simRate, steady, set.units == "V");
     EffectModel current;
     if (o.fitNuisances) {
         say("calibration: tension and bow position", 0.0);
@@ -494,47 +494,21 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         d.finalSim[i] = engine.simulate(d.final, i, &d.finalForce[i]);
         d.measuredForce[i].assign(strokes[i].force.begin(), strokes[i].force.begin() + static_cast<long>(std::min(strokes[i].force.size(), d.baselineForce[i].size())));
     });
-    // 5. The ramps' scale assumed a string that does not roll. A named torsion makes the pre-slip
-    //    ramps softer (part of the bow's travel rolls the string), so the scale takes the factor
-    //    the final model shows between its ramps with torsion and without, both at the manifest's
-    //    tension and bow position: those nuisances trade one for one with the scale and absorb
-    //    other mismatch, and letting them move it made it worse on reference sets (docs/diagnosis.md).
+    // 5. The ramps' scale assumed a string that does not roll. Every fit compared a rolling model
+    //    in that scale (Engine::recordedGain); a named torsion now says how much softer the ramps
+    //    were, so the reported scale takes that factor (the final model's, at its own Z_t/Z_0).
     if (set.units == "V" && has(d.final.effects, "torsional_compliance")) {
-        EffectModel rolling = d.final;
-        rolling.params.erase("tension_scale");
-        rolling.params.erase("beta_scale");
-        const EffectModel still = removed(rolling, "torsional_compliance");
-        std::vector<std::size_t> quasiStatic;
-        for (std::size_t i = 0; i < n; ++i)
-            if (d.measured[i].firstSlip > 4.0 / info.f0) quasiStatic.push_back(i);
-        // One model per pass: a thread's voice is prepared again whenever the model changes.
-        std::vector<std::vector<double>> rolled(quasiStatic.size()), held(quasiStatic.size());
-        tbb::parallel_for(std::size_t(0), quasiStatic.size(), [&](std::size_t k) { engine.simulate(rolling, quasiStatic[k], &rolled[k]); });
-        tbb::parallel_for(std::size_t(0), quasiStatic.size(), [&](std::size_t k) { engine.simulate(still, quasiStatic[k], &held[k]); });
-        double ab = 0, bb = 0;
-        for (std::size_t k = 0; k < quasiStatic.size(); ++k) {
-            const auto& a = rolled[k];
-            const auto& b = held[k];
-            const auto from = static_cast<std::size_t>(2.0 / info.f0 * o.simRate);
-            const auto to = static_cast<std::size_t>(0.6 * d.measured[quasiStatic[k]].firstSlip * o.simRate);
-            for (std::size_t j = from; j < to && j < a.size() && j < b.size(); ++j) {
-                ab += a[j] * b[j];
-                bb += b[j] * b[j];
+        const double softer = rollingSoftening(engine.config(d.final));
+        d.scale *= softer;
+        for (auto& c : d.calibration)
+            if (c.name == "scale_n_per_unit") {
+                c.value *= softer;
+                c.low *= softer;
+                c.high *= softer;
+                char note[96];
+                std::snprintf(note, sizeof note, "; times %.3f, the named torsion's softening of the ramps", softer);
+                c.meaning += note;
             }
-        }
-        if (ab > 0 && bb > 0) {
-            const double softer = ab / bb;
-            d.scale *= softer;
-            for (auto& c : d.calibration)
-                if (c.name == "scale_n_per_unit") {
-                    c.value *= softer;
-                    c.low *= softer;
-                    c.high *= softer;
-                    char note[96];
-                    std::snprintf(note, sizeof note, "; times %.3f, the named torsion's softening of the ramps", softer);
-                    c.meaning += note;
-                }
-        }
     }
     // 6. Two-ended steady strokes: bow-point velocity and friction reconstructed from the end
     //    forces, measured and as the final model would show them.

@@ -137,8 +137,23 @@ std::vector<double> strokeNoise(std::size_t stroke, std::size_t length, double l
 }
 } // namespace
 
-Engine::Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady)
-    : strokes_(strokes), info_(info), fs_(fs), steady_(steady), noise_(strokes.size())
+double rollingSoftening(const dsp::BowedStringConfig& c)
+{
+    if (!c.waveguide.torsion) return 1.0;
+    return 1.0 / (1.0 + 1.0 / (c.string.torsionImpedanceRatio * c.string.torsionSpeedRatio));
+}
+
+double Engine::recordedGain(const EffectModel& m) const
+{
+    // The ramps' scale made a rolling string's forces look larger by 1 / softening (the same
+    // ramp, read as a stiffer string's): a rolling model is compared in that scale, so its
+    // quasi-static signature (a later first slip at the same force) is not hidden by the scale.
+    return scaleFromRamps_ ? 1.0 / rollingSoftening(config(m)) : 1.0;
+}
+
+Engine::Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady,
+               bool scaleFromRamps)
+    : strokes_(strokes), info_(info), fs_(fs), steady_(steady), scaleFromRamps_(scaleFromRamps), noise_(strokes.size())
 {
     tbb::parallel_for(std::size_t(0), strokes.size(), [&](std::size_t i) {
         if (strokes[i].noise > 0.0) noise_[i] = strokeNoise(i, strokes[i].force.size(), strokes[i].noise, 0);
@@ -160,11 +175,11 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
     }
     dsp::BowedString<double>& s = *v.string;
     const Prepared& p = strokes_[i];
-    const double b = beta(m);
+    const double b = beta(m), gain = recordedGain(m);
     std::vector<double> out(p.force.size());
     for (std::size_t n = 0; n < out.size(); ++n) {
         const auto c = p.gesture.at(static_cast<double>(n) / fs_);
-        out[n] = s.processSample(c.force * (1.0 + jitterF), c.speed * (1.0 + jitterA), b);
+        out[n] = gain * s.processSample(c.force * (1.0 + jitterF), c.speed * (1.0 + jitterA), b);
     }
     ++simulations_;
     if (head) head->assign(out.begin(), out.begin() + static_cast<long>(std::min(out.size(), static_cast<std::size_t>(12.0 * fs_ / info_.f0 + 0.02 * fs_))));

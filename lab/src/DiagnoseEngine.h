@@ -88,6 +88,12 @@ struct RigUnknown {
 /// it is not in the model).
 std::vector<RigUnknown> rigUnknowns(const EffectModel& m);
 
+/// Quasi-static share of the bow's travel that deflects the string rather than rolling it: the
+/// bow point's transverse stiffness T / (beta (1 - beta) L) in series with the torsional one,
+/// Z_t c_t / (beta (1 - beta) L), so K_eff / K_transverse = 1 / (1 + Z_0 c / (Z_t c_t)); 1 without
+/// torsion. The pre-slip ramps of a rolling string are that much softer.
+double rollingSoftening(const dsp::BowedStringConfig& c);
+
 class Engine;
 
 /// One extension the diagnosis may try: the effects it adds and the parameters it fits.
@@ -158,12 +164,17 @@ SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts);
 
 class Engine {
 public:
-    /// The strokes must keep their length and noise level while the engine lives.
-    Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady);
+    /// The strokes must keep their length and noise level while the engine lives. `scaleFromRamps`:
+    /// the recordings' scale was taken from their pre-slip ramps assuming a string that does not roll.
+    Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady,
+           bool scaleFromRamps = false);
 
     /// The voice of model m: its effects, the set's steady-sliding curve and the nuisances.
     dsp::BowedStringConfig config(const EffectModel& m) const;
     double beta(const EffectModel& m) const;
+    /// What model m's simulated bridge force is multiplied by before it meets the recordings: 1,
+    /// except for a rolling string when the scale came from the ramps (rollingSoftening()).
+    double recordedGain(const EffectModel& m) const;
     /// Simulated features of stroke i under model m as the rig would record them: the
     /// recording's own noise level is added (from a fixed seed per stroke, so a fit sees a
     /// smooth objective) and the first slip is found as in a recording. Force and acceleration
@@ -186,6 +197,7 @@ private:
     StringInfo info_;
     double fs_;
     std::optional<dsp::SteadyCurve> steady_;
+    bool scaleFromRamps_ = false;
     /// Each stroke's own noise (seed 0), drawn once: every evaluation adds the same to that stroke.
     std::vector<std::vector<double>> noise_;
     mutable std::atomic<long long> simulations_{0};
