@@ -145,14 +145,11 @@ double rollingSoftening(const dsp::BowedStringConfig& c)
 
 double Engine::recordedGain(const EffectModel& m) const
 {
-    // The ramps' scale made a rolling string's forces look larger by 1 / softening (the same
-    // ramp, read as a stiffer string's): a rolling model is compared in that scale, so its
-    // quasi-static signature (a later first slip at the same force) is not hidden by the scale.
-    // In that scale the signature is a later first slip at a higher force: exactly what a higher
-    // static friction gives. Steady sliding pins the friction curve's static level, but a thermal
-    // model's moves with a rosin shift or a rate law, and there a torsion compared this way stood
-    // in for a -17 K shift (model-made set 24, docs/diagnosis-study.md): a thermal model is
-    // compared unscaled, torsion then showing only in the dynamics.
+    // The ramps' scale made a rolling string's forces 1 / softening too large; a rolling model
+    // is compared in that scale, where it slips later at a higher force. So does a higher static
+    // friction: steady sliding pins the friction curve's, but a thermal model's moves with a
+    // shift or a rate law (torsion stood in for a -17 K shift there), so thermal models are
+    // compared unscaled (docs/diagnosis.md, step 2).
     const bool thermal = std::find(m.effects.begin(), m.effects.end(), "thermal_memory") != m.effects.end();
     return scaleFromRamps_ && !thermal ? 1.0 / rollingSoftening(config(m)) : 1.0;
 }

@@ -173,7 +173,8 @@ public:
     dsp::BowedStringConfig config(const EffectModel& m) const;
     double beta(const EffectModel& m) const;
     /// What model m's simulated bridge force is multiplied by before it meets the recordings: 1,
-    /// except for a rolling string when the scale came from the ramps (rollingSoftening()).
+    /// except for a rolling string without thermal memory when the scale came from the ramps
+    /// (1 / rollingSoftening()).
     double recordedGain(const EffectModel& m) const;
     /// Simulated features of stroke i under model m as the rig would record them: the
     /// recording's own noise level is added (from a fixed seed per stroke, so a fit sees a
