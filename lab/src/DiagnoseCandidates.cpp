@@ -81,8 +81,8 @@ std::vector<RigUnknown> rigUnknowns(const EffectModel& m)
             out.push_back({"contact_radius", "contact radius " + std::to_string(std::lround(um)) + " um", {}, {{"contact_radius_scale", um * 1e-6 / a}}});
     // Torsion: beside thermal memory mostly below the metric's floor (docs/diagnosis-study.md),
     // yet a rolling string softens the pre-slip ramp (and inflates a ramp-read scale, which the
-    // move carries as every fit does: Engine::recordedGain), which p and the load exponent take up. Z_t/Z_0 = 2 is a string that rolls readily (the reference
-    // rigs draw 1.2-8).
+    // move carries as every fit does: Engine::recordedGain), which p and the load exponent take
+    // up. Z_t/Z_0 = 2 is a string that rolls readily (the reference rigs draw 1.2-8).
     if (!has(m.effects, "torsional_compliance"))
         out.push_back({"torsion", "torsion at Z_t/Z_0 = 2", {"torsional_compliance"}, {{"zt_ratio", 2.0}}});
     return out;

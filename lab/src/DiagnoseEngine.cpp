@@ -143,7 +143,7 @@ double rollingSoftening(const dsp::BowedStringConfig& c)
     return 1.0 / (1.0 + 1.0 / (c.string.torsionImpedanceRatio * c.string.torsionSpeedRatio));
 }
 
-double Engine::recordedGain(const EffectModel& m) const
+double Engine::recordedGain(const EffectModel& m, const dsp::BowedStringConfig& c) const
 {
     // The ramps' scale made a rolling string's forces 1 / softening too large; a rolling model
     // is compared in that scale, where it slips later at a higher force. So does a higher static
@@ -151,7 +151,7 @@ double Engine::recordedGain(const EffectModel& m) const
     // shift or a rate law (torsion stood in for a -17 K shift there), so thermal models are
     // compared unscaled (docs/diagnosis.md, step 2).
     const bool thermal = std::find(m.effects.begin(), m.effects.end(), "thermal_memory") != m.effects.end();
-    return scaleFromRamps_ && !thermal ? 1.0 / rollingSoftening(config(m)) : 1.0;
+    return scaleFromRamps_ && !thermal ? 1.0 / rollingSoftening(c) : 1.0;
 }
 
 Engine::Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady,
@@ -171,14 +171,16 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
     Voice& v = voices_.local();
     if (!v.string || v.model.effects != m.effects || v.model.params != m.params) {
         if (!v.string) v.string = std::make_unique<dsp::BowedString<double>>();
-        v.string->prepare(fs_, config(m));
+        const dsp::BowedStringConfig c = config(m);
+        v.string->prepare(fs_, c);
         v.model = m;
+        v.gain = recordedGain(m, c);
     } else {
         v.string->reset();
     }
     dsp::BowedString<double>& s = *v.string;
     const Prepared& p = strokes_[i];
-    const double b = beta(m), gain = recordedGain(m);
+    const double b = beta(m), gain = v.gain;
     std::vector<double> out(p.force.size());
     for (std::size_t n = 0; n < out.size(); ++n) {
         const auto c = p.gesture.at(static_cast<double>(n) / fs_);

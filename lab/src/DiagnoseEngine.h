@@ -172,10 +172,6 @@ public:
     /// The voice of model m: its effects, the set's steady-sliding curve and the nuisances.
     dsp::BowedStringConfig config(const EffectModel& m) const;
     double beta(const EffectModel& m) const;
-    /// What model m's simulated bridge force is multiplied by before it meets the recordings: 1,
-    /// except for a rolling string without thermal memory when the scale came from the ramps
-    /// (1 / rollingSoftening()).
-    double recordedGain(const EffectModel& m) const;
     /// Simulated features of stroke i under model m as the rig would record them: the
     /// recording's own noise level is added (from a fixed seed per stroke, so a fit sees a
     /// smooth objective) and the first slip is found as in a recording. Force and acceleration
@@ -193,7 +189,12 @@ private:
     struct Voice {
         EffectModel model;
         std::unique_ptr<dsp::BowedString<double>> string;
+        double gain = 1.0; ///< recordedGain() of the model, taken when the voice is prepared
     };
+    /// What model m (voice config c) has its simulated bridge force multiplied by before it meets
+    /// the recordings: 1, except for a rolling string without thermal memory when the scale came
+    /// from the ramps (1 / rollingSoftening()).
+    double recordedGain(const EffectModel& m, const dsp::BowedStringConfig& c) const;
     std::vector<Prepared>& strokes_;
     StringInfo info_;
     double fs_;
