@@ -28,17 +28,37 @@ cat > "$work/home/.config/Rosin.settings" <<'XML'
   </VALUE>
 </PROPERTIES>
 XML
-export HOME="$work/home" JACK_DEFAULT_SERVER="$server" DISPLAY="$display" JACK_NO_AUDIO_RESERVATION=1
-jackd --no-realtime -n "$server" -d dummy -r 48000 -p 256 >"$work/jack.log" 2>&1 &
-jack_pid=$!
+# JACK_NO_START_SERVER: a client must find our server, never start a default one of its own.
+export HOME="$work/home" JACK_DEFAULT_SERVER="$server" DISPLAY="$display" JACK_NO_AUDIO_RESERVATION=1 \
+  JACK_NO_START_SERVER=1
 Xvfb "$display" -screen 0 1400x900x24 -nolisten tcp >"$work/xvfb.log" 2>&1 &
 xvfb_pid=$!
-for _ in $(seq 50); do jack_lsp >/dev/null 2>&1 && xdpyinfo >/dev/null 2>&1 && break; sleep 0.2; done
+# On a loaded machine jackd has once failed to come up within the old 10 s wait, and the test went
+# on without it: wait for it by asking it for its ports, start it again if it died, and stop with
+# its log when it never answers, so a missing server is never mistaken for a Standalone fault.
+jack_up=0
+for attempt in 1 2 3; do
+  jackd --no-realtime -n "$server" -d dummy -r 48000 -p 256 >"$work/jack-$attempt.log" 2>&1 &
+  jack_pid=$!
+  for _ in $(seq 100); do
+    if jack_lsp >/dev/null 2>&1; then jack_up=1; break; fi
+    kill -0 "$jack_pid" 2>/dev/null || break
+    sleep 0.2
+  done
+  [ "$jack_up" -eq 1 ] && break
+  echo "jackd (attempt $attempt) did not answer:"; cat "$work/jack-$attempt.log"
+  kill "$jack_pid" 2>/dev/null || true; wait "$jack_pid" 2>/dev/null || true
+done
+[ "$jack_up" -eq 1 ] || { echo "FAIL: no JACK server to test the Standalone on"; exit 1; }
+for _ in $(seq 100); do xdpyinfo >/dev/null 2>&1 && break; sleep 0.2; done
+xdpyinfo >/dev/null 2>&1 || { echo "FAIL: no X display"; cat "$work/xvfb.log"; exit 1; }
 "$app" >"$work/app.log" 2>&1 &
 app_pid=$!
 win="$(timeout 20 xdotool search --sync --name '^Rosin$' | head -1)"
 sleep 2
-jack_lsp | grep -q "Rosin:out_1" || { echo "FAIL: the Standalone did not open JACK"; cat "$work/app.log"; exit 1; }
+# The Standalone opens its device a moment after its window appears: give it up to 10 s.
+for _ in $(seq 50); do jack_lsp | grep -q "Rosin:out_1" && break; sleep 0.2; done
+jack_lsp | grep -q "Rosin:out_1" || { echo "FAIL: the Standalone did not open JACK"; cat "$work/app.log" "$work"/jack-*.log; exit 1; }
 eval "$(xdotool getwindowgeometry --shell "$win")" # X Y WIDTH HEIGHT
 import -window root "$out/standalone-before.png"
 # Hold a key in the middle of the keyboard strip along the bottom of the window.
