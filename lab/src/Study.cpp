@@ -176,6 +176,9 @@ std::vector<StudySet> planStudy(const StudyOptions& o)
 void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<void(const std::string&, double)>& progress)
 {
     const std::vector<StudySet> plan = planStudy(o);
+    for (const int k : o.only)
+        if (k < 0 || k >= static_cast<int>(plan.size()))
+            throw LabError("study --only: set " + std::to_string(k) + " is not in a plan of " + std::to_string(plan.size()) + " sets");
     const Distributed& mpi = Distributed::instance();
     json planJson = json::array();
     for (const auto& p : plan) planJson.push_back({{"index", p.index}, {"seed", p.seed}, {"effects", p.effects}});
@@ -200,6 +203,8 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     for (const StudySet& p : plan) {
         ++done;
         if (p.index % mpi.size() != mpi.rank()) continue;
+        if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), p.index) == o.only.end()) continue;
+        if (!o.hiding.empty() && std::find(p.effects.begin(), p.effects.end(), o.hiding) == p.effects.end()) continue;
         char name[16];
         std::snprintf(name, sizeof name, "%03d", p.index);
         const fs::path here = dir / "sets" / name;

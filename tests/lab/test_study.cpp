@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <tuple>
 #include <filesystem>
 #include <fstream>
@@ -114,6 +115,57 @@ TEST(Study, AFolderResumesOnlyTheStudyItHolds)
     }
     EXPECT_FALSE(fs::exists(dir / "sets")) << "nothing is started in a refused folder";
     fs::remove_all(dir);
+}
+
+// A study's hard cases can be run again alone: --only and --hiding pick sets of the whole plan
+// (which stays the folder's plan, so a later full run resumes it).
+TEST(Study, RunsOnlyThePickedSetsOfTheWholePlan)
+{
+    const fs::path dir = freshDir("only");
+    StudyOptions o;
+    o.sets = 4;
+    o.nulls = 1;
+    o.grid = 4;
+    o.seed = 12;
+    o.generateOnly = true; // simulating is enough to see which sets ran
+    o.only = {2};
+    runStudy(dir, o);
+    for (int k = 0; k < o.sets; ++k) {
+        char name[8];
+        std::snprintf(name, sizeof name, "%03d", k);
+        EXPECT_EQ(fs::exists(dir / "sets" / name / "truth.json"), k == 2) << name;
+    }
+    // The folder's plan is the whole study, so the same folder accepts the rest later.
+    json plan;
+    std::ifstream(dir / "plan.json") >> plan;
+    EXPECT_EQ(plan["sets"].size(), 4u);
+
+    const std::vector<StudySet> whole = planStudy(o);
+    const auto hider = std::find_if(whole.begin(), whole.end(), [](const StudySet& s) { return !s.effects.empty(); });
+    ASSERT_NE(hider, whole.end());
+    StudyOptions byEffect = o;
+    byEffect.only.clear();
+    byEffect.hiding = hider->effects.front();
+    const fs::path dir2 = freshDir("hiding");
+    runStudy(dir2, byEffect);
+    int made = 0;
+    for (const StudySet& s : whole) {
+        char name[8];
+        std::snprintf(name, sizeof name, "%03d", s.index);
+        const bool hides = std::find(s.effects.begin(), s.effects.end(), byEffect.hiding) != s.effects.end();
+        EXPECT_EQ(fs::exists(dir2 / "sets" / name / "truth.json"), hides) << name;
+        made += hides;
+    }
+    EXPECT_GE(made, 1);
+    EXPECT_LT(made, o.sets);
+
+    StudyOptions outside = o;
+    outside.only = {4};
+    const fs::path dir3 = freshDir("outside");
+    EXPECT_THROW(runStudy(dir3, outside), LabError);
+    fs::remove_all(dir);
+    fs::remove_all(dir3);
+    fs::remove_all(dir2);
 }
 
 // Sets can be simulated on one occasion and diagnosed on another (a new diagnosis on the same

@@ -26,6 +26,10 @@ struct StudyOptions {
     std::string gesture = "guettler";
     bool keepSets = false;     ///< keep the generated WAV sets (regenerable from their seeds)
     bool generateOnly = false; ///< simulate and keep the sets, diagnose none (a later run diagnoses the kept sets)
+    /// Run only these planned sets now (by index; empty = all) and only those hiding this effect
+    /// (empty = any): a later run of the same folder does the rest. The plan is always the whole.
+    std::vector<int> only;
+    std::string hiding;
     DiagnoseOptions diagnose;
     bool quiet = false;
 };
