@@ -36,7 +36,7 @@ struct StudyCommand {
         cmd->add_option("--oversampling", options.oversampling, "Reference simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         cmd->add_option("--diagnose-seed", options.diagnose.seed, "Seed of each diagnosis's split and bootstraps")->capture_default_str();
         cmd->add_flag("--keep-sets", options.keepSets, "Keep the generated WAV sets");
-        cmd->add_option("--only", options.only, "Run only these sets (indices; the folder's plan stays the whole study)")->check(CLI::NonNegativeNumber);
+        cmd->add_option("--only", options.only, "Run only these sets (indices, e.g. 3,13; the folder's plan stays the whole study)")->delimiter(',')->check(CLI::NonNegativeNumber);
         cmd->add_option("--hiding", options.hiding, "Run only the sets that hide this effect")->check(CLI::IsMember(effectIds()));
         cmd->add_flag("--generate-only", options.generateOnly,
                       "Only simulate the sets and keep them; a later run without it diagnoses the kept sets instead of simulating them again");
