@@ -55,6 +55,14 @@ inline double median(std::vector<double> v)
     return v[v.size() / 2];
 }
 
+/// A rosin shift and the bow side's effusivity look alike in Guettler strokes: a shift of s K
+/// fits about as well as an effusivity scale 1 + s / kShiftPerEffusivity with r_A free (measured
+/// on study sets: 13-22 K per unit; docs/diagnosis.md).
+constexpr double kShiftPerEffusivity = 18.0;
+/// The report's paragraph saying so, with the shift the calibrated effusivity could equally be;
+/// empty when the effusivity was not calibrated or a shift is in the final model.
+std::string shiftOrEffusivityNote(const Diagnosis& d);
+
 /// A finding's evidence in plain words: which part of the comparison the extension mended most.
 std::string describe(const std::string& effect, const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after,
                      const std::vector<std::size_t>& ids, const EffectModel& from, double errBefore, double errAfter);

@@ -196,6 +196,25 @@ TEST(DiagnoseParameters, PhysicalParametersBelongToFindingsAndNuisancesToTheCali
     }
 }
 
+// A thermal diagnosis without a named shift says which shift its calibrated effusivity could
+// equally be (the two trade on Guettler data); with a shift named, or no effusivity fitted, it
+// says nothing of the kind.
+TEST(DiagnoseParameters, TheReportSaysWhichShiftTheCalibratedEffusivityCouldBe)
+{
+    Diagnosis d;
+    d.final.effects = {"thermal_memory"};
+    EXPECT_EQ(diag::shiftOrEffusivityNote(d), "") << "no effusivity in the calibration";
+    d.calibration.push_back({"rod_effusivity_scale", "bow-side effusivity", 1.31, 1.24, 1.35});
+    const std::string note = diag::shiftOrEffusivityNote(d);
+    EXPECT_NE(note.find("came out 1.31"), std::string::npos) << note;
+    EXPECT_NE(note.find("shift of +6 K"), std::string::npos) << note; // 18 K x 0.31
+    EXPECT_NE(note.find("0.65-1.35"), std::string::npos) << note;
+    d.calibration.back().value = 0.86;
+    EXPECT_NE(diag::shiftOrEffusivityNote(d).find("shift of -3 K"), std::string::npos) << diag::shiftOrEffusivityNote(d);
+    d.final.effects.push_back("rosin_temperature_shift");
+    EXPECT_EQ(diag::shiftOrEffusivityNote(d), "") << "a named shift is a finding, not an alternative";
+}
+
 TEST(DiagnoseConsistency, ReportsNoneWhenTheBaselineMadeTheData) { check({{}, 21}); }
 
 TEST(DiagnoseConsistency, FindsHertzianContactAtAnotherRateWithAnotherReflectionDesign) { check({{"hertzian_contact"}, 27, 44100, true}); }
