@@ -199,12 +199,17 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     fs::create_directories(dir / "sets");
     if (mpi.isRoot() && !fs::exists(dir / "plan.json")) std::ofstream(dir / "plan.json") << planJson.dump(1) << "\n";
     mpi.barrier();
+    // The sets to run now are picked before they are dealt to ranks, so a few picked sets spread
+    // over the ranks rather than falling to whichever ranks their plan indices name.
+    std::vector<StudySet> picked;
+    for (const StudySet& p : plan)
+        if ((o.only.empty() || std::find(o.only.begin(), o.only.end(), p.index) != o.only.end()) &&
+            (o.hiding.empty() || std::find(p.effects.begin(), p.effects.end(), o.hiding) != p.effects.end()))
+            picked.push_back(p);
     std::size_t done = 0;
-    for (const StudySet& p : plan) {
+    for (const StudySet& p : picked) {
         ++done;
-        if (p.index % mpi.size() != mpi.rank()) continue;
-        if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), p.index) == o.only.end()) continue;
-        if (!o.hiding.empty() && std::find(p.effects.begin(), p.effects.end(), o.hiding) == p.effects.end()) continue;
+        if (static_cast<int>((done - 1) % static_cast<std::size_t>(mpi.size())) != mpi.rank()) continue;
         char name[16];
         std::snprintf(name, sizeof name, "%03d", p.index);
         const fs::path here = dir / "sets" / name;
@@ -218,7 +223,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             fs::create_directories(here);
         }
         auto say = [&](const std::string& what, double x) {
-            if (progress) progress("set " + std::string(name) + " (" + joined(p.effects) + "): " + what, (static_cast<double>(done - 1) + x) / static_cast<double>(plan.size()));
+            if (progress) progress("set " + std::string(name) + " (" + joined(p.effects) + "): " + what, (static_cast<double>(done - 1) + x) / static_cast<double>(picked.size()));
         };
         SynthSpec spec;
         spec.generator = "reference";
