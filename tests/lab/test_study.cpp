@@ -29,13 +29,20 @@ fs::path freshDir(const std::string& name)
     return dir;
 }
 
-void writeSet(const fs::path& dir, int index, const json& truth, const json& diagnosis)
+/// The folder a study keeps set `index` in (DIR/sets/NNN).
+fs::path setDir(const fs::path& dir, int index)
 {
     char name[16];
     std::snprintf(name, sizeof name, "%03d", index);
-    fs::create_directories(dir / "sets" / name / "diagnosis");
-    std::ofstream(dir / "sets" / name / "truth.json") << truth.dump();
-    std::ofstream(dir / "sets" / name / "diagnosis" / "diagnosis.json") << diagnosis.dump();
+    return dir / "sets" / name;
+}
+
+void writeSet(const fs::path& dir, int index, const json& truth, const json& diagnosis)
+{
+    const fs::path here = setDir(dir, index);
+    fs::create_directories(here / "diagnosis");
+    std::ofstream(here / "truth.json") << truth.dump();
+    std::ofstream(here / "diagnosis" / "diagnosis.json") << diagnosis.dump();
 }
 
 json finding(const std::string& effect, const std::string& parameter, double value, double low, double high)
@@ -130,11 +137,7 @@ TEST(Study, RunsOnlyThePickedSetsOfTheWholePlan)
     o.generateOnly = true; // simulating is enough to see which sets ran
     o.only = {2};
     runStudy(dir, o);
-    for (int k = 0; k < o.sets; ++k) {
-        char name[8];
-        std::snprintf(name, sizeof name, "%03d", k);
-        EXPECT_EQ(fs::exists(dir / "sets" / name / "truth.json"), k == 2) << name;
-    }
+    for (int k = 0; k < o.sets; ++k) EXPECT_EQ(fs::exists(setDir(dir, k) / "truth.json"), k == 2) << k;
     // The folder's plan is the whole study, so the same folder accepts the rest later.
     json plan;
     std::ifstream(dir / "plan.json") >> plan;
@@ -150,10 +153,8 @@ TEST(Study, RunsOnlyThePickedSetsOfTheWholePlan)
     runStudy(dir2, byEffect);
     int made = 0;
     for (const StudySet& s : whole) {
-        char name[8];
-        std::snprintf(name, sizeof name, "%03d", s.index);
         const bool hides = std::find(s.effects.begin(), s.effects.end(), byEffect.hiding) != s.effects.end();
-        EXPECT_EQ(fs::exists(dir2 / "sets" / name / "truth.json"), hides) << name;
+        EXPECT_EQ(fs::exists(setDir(dir2, s.index) / "truth.json"), hides) << s.index;
         made += hides;
     }
     EXPECT_GE(made, 1);
