@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -196,24 +197,47 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
     return features(std::move(out), fs_, p.gesture, info_, true);
 }
 
+namespace {
+// A bootstrap resample names about a third of its strokes twice or more; a stroke's simulation
+// depends only on the model and the stroke, so each distinct stroke is simulated once.
+std::vector<std::size_t> distinct(const std::vector<std::size_t>& which)
+{
+    std::vector<std::size_t> d(which);
+    std::sort(d.begin(), d.end());
+    d.erase(std::unique(d.begin(), d.end()), d.end());
+    return d;
+}
+
+std::size_t slot(const std::vector<std::size_t>& distinctStrokes, std::size_t stroke)
+{
+    return static_cast<std::size_t>(std::lower_bound(distinctStrokes.begin(), distinctStrokes.end(), stroke) - distinctStrokes.begin());
+}
+} // namespace
+
 std::vector<ErrorParts> Engine::errors(const EffectModel& m, const std::vector<std::size_t>& which) const
 {
-    std::vector<ErrorParts> e(which.size());
-    tbb::parallel_for(std::size_t(0), which.size(), [&](std::size_t k) {
-        const std::size_t i = which[k];
-        e[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].gesture, info_);
+    const std::vector<std::size_t> strokes = distinct(which);
+    std::vector<ErrorParts> once(strokes.size());
+    tbb::parallel_for(std::size_t(0), strokes.size(), [&](std::size_t k) {
+        const std::size_t i = strokes[k];
+        once[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].gesture, info_);
     });
+    std::vector<ErrorParts> e(which.size());
+    for (std::size_t k = 0; k < which.size(); ++k) e[k] = once[slot(strokes, which[k])];
     return e;
 }
 
 Eigen::VectorXd Engine::signedResiduals(const EffectModel& m, const std::vector<std::size_t>& which) const
 {
-    Eigen::VectorXd r(static_cast<Eigen::Index>(4 * which.size()));
-    tbb::parallel_for(std::size_t(0), which.size(), [&](std::size_t k) {
-        const std::size_t i = which[k];
-        const auto p = signedParts(strokes_[i].feat, simulate(m, i), strokes_[i].gesture);
-        for (std::size_t j = 0; j < 4; ++j) r[static_cast<Eigen::Index>(4 * k + j)] = p[j];
+    const std::vector<std::size_t> strokes = distinct(which);
+    std::vector<std::array<double, 4>> once(strokes.size());
+    tbb::parallel_for(std::size_t(0), strokes.size(), [&](std::size_t k) {
+        const std::size_t i = strokes[k];
+        once[k] = signedParts(strokes_[i].feat, simulate(m, i), strokes_[i].gesture);
     });
+    Eigen::VectorXd r(static_cast<Eigen::Index>(4 * which.size()));
+    for (std::size_t k = 0; k < which.size(); ++k)
+        for (std::size_t j = 0; j < 4; ++j) r[static_cast<Eigen::Index>(4 * k + j)] = once[slot(strokes, which[k])][j];
     return r;
 }
 

@@ -142,6 +142,52 @@ TEST(DiagnoseSystematic, TheGaussNewtonMoveUndoesALinearChangeAndLeavesFlatDirec
     EXPECT_LT(diag::gaussNewtonShift(J, orthogonal).norm(), 1e-12);
 }
 
+// A bootstrap resample repeats strokes; the engine simulates each distinct stroke once and scores
+// it as often as it appears. The scores must be those of the strokes taken one at a time, in the
+// resample's order, for the error parts and the signed residuals alike.
+TEST(DiagnoseSystematic, ARepeatedStrokeIsSimulatedOnceAndScoredAsOftenAsItAppears)
+{
+    const fs::path dir = fs::temp_directory_path() / ("rosin-diag-repeat-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    SynthSpec spec;
+    spec.effects = {"thermal_memory"};
+    spec.seed = 31;
+    spec.grid = 4;
+    SynthTruth truth;
+    writeMeasurementSet(dir / "set", synthesize(spec, truth), SF_FORMAT_PCM_24);
+    const MeasurementSet set = readMeasurementSet(dir / "set");
+    fs::remove_all(dir);
+    const rosin::dsp::StringParams ref = rosin::dsp::StringParams::celloD();
+    diag::StringInfo info{set.f0, set.beta, 0, set.tension.value_or(ref.tension), set.length.value_or(ref.length)};
+    info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
+    DiagnoseOptions o;
+    Diagnosis d;
+    std::vector<diag::Prepared> strokes = diag::prepareStrokes(set, info, o, d);
+    ASSERT_EQ(strokes.size(), 16u);
+    const diag::Engine engine(strokes, info, o.simRate, std::nullopt, false);
+    for (const EffectModel& m : {EffectModel{}, EffectModel{{"thermal_memory"}, {{"r_A", 1.1}}}}) {
+        const std::vector<std::size_t> resample{9, 2, 9, 14, 2, 9, 0};
+        const std::vector<ErrorParts> together = engine.errors(m, resample);
+        const Eigen::VectorXd signedTogether = engine.signedResiduals(m, resample);
+        ASSERT_EQ(together.size(), resample.size());
+        ASSERT_EQ(signedTogether.size(), 4 * static_cast<Eigen::Index>(resample.size()));
+        for (std::size_t k = 0; k < resample.size(); ++k) {
+            const ErrorParts alone = engine.errors(m, {resample[k]}).front();
+            EXPECT_EQ(together[k].firstSlip, alone.firstSlip) << m.name() << " position " << k;
+            EXPECT_EQ(together[k].forceBeforeSlip, alone.forceBeforeSlip) << m.name() << " position " << k;
+            EXPECT_EQ(together[k].jump, alone.jump) << m.name() << " position " << k;
+            EXPECT_EQ(together[k].transient, alone.transient) << m.name() << " position " << k;
+            EXPECT_EQ(together[k].waveform, alone.waveform) << m.name() << " position " << k;
+            const Eigen::VectorXd signedAlone = engine.signedResiduals(m, {resample[k]});
+            for (Eigen::Index j = 0; j < 4; ++j) EXPECT_EQ(signedTogether[static_cast<Eigen::Index>(4 * k) + j], signedAlone[j]);
+        }
+        // the strokes differ, so a score put in the wrong place would show
+        EXPECT_NE(together[0].total(), together[1].total()) << m.name();
+        EXPECT_NE(together[1].total(), together[3].total()) << m.name();
+    }
+}
+
 // A rolling string's quasi-static softening, as the diagnosis takes it (the bow point's transverse
 // stiffness in series with the torsional one), against the waveguide's own pre-slip ramps: a
 // slow Guettler stroke with torsion at Z_t/Z_0 = 2 and 4 and without, compared by least squares
