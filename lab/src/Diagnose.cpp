@@ -249,13 +249,27 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             std::mt19937_64 prng(o.seed * 31ull + static_cast<std::uint64_t>(round));
             std::uniform_int_distribution<std::size_t> pick(0, fitSet.size() - 1);
             std::uniform_real_distribution<double> jump(-0.15, 0.15);
+            // the estimate's error on a resample, from its per-stroke errors on the fit strokes
+            const std::vector<ErrorParts> estimateOnFit = engine.errors(cand, fitSet);
             for (int b = 0; b < o.parameterBootstrap; ++b) {
                 std::vector<std::size_t> resampled;
-                for (std::size_t k = 0; k < fitSet.size(); ++k) resampled.push_back(fitSet[pick(prng)]);
+                std::vector<ErrorParts> estimateOnResample;
+                for (std::size_t k = 0; k < fitSet.size(); ++k) {
+                    const std::size_t at = pick(prng);
+                    resampled.push_back(fitSet[at]);
+                    estimateOnResample.push_back(estimateOnFit[at]);
+                }
                 std::vector<double> start = t.x;
                 for (std::size_t k = 0; k < start.size(); ++k)
                     start[k] = std::clamp(start[k] + jump(prng) * (t.c.hi[k] - t.c.lo[k]), t.c.lo[k], t.c.hi[k]);
-                refits.push_back(diag::fit(engine, current, t.c, resampled, start, std::max(8, o.maxEvaluations / 2), 0.1, nullptr, false));
+                const int evaluations = std::max(8, o.maxEvaluations / 2);
+                double refitError = 0.0;
+                std::vector<double> refit = diag::fit(engine, current, t.c, resampled, start, evaluations, 0.1, &refitError, false);
+                // A refit that ends worse on its own resample than the estimate has not converged
+                // (a few COBYLA steps for five or more parameters): search again from the estimate.
+                if (mean(estimateOnResample) < refitError)
+                    refit = diag::fit(engine, current, t.c, resampled, t.x, evaluations, 0.05, nullptr, false);
+                refits.push_back(std::move(refit));
             }
             halfWidth.clear();
             bool atNullInterval = false;
@@ -351,7 +365,20 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 w.share = e > 0 ? (e - mean(currentVal)) / e : 0.0;
                 tested.push_back(std::move(w));
             }
-            const auto weakest = std::min_element(tested.begin(), tested.end(), [](const Without& a, const Without& b) { return a.share < b.share; });
+            // An earlier finding whose parameter the joint refit moved to where its interval (the
+            // half-width it was named with) reaches the no-effect value fails rule 4 now.
+            auto movedToNull = [&](const Without& w) {
+                for (const auto& f : d.findings)
+                    if (f.effect == w.effect)
+                        for (const auto& [name, v] : f.parameters) {
+                            const double half = 0.5 * (v[2] - v[1]), now = current.params.at(name);
+                            if (intervalAtNull(name, now - half, now + half)) return true;
+                        }
+                return false;
+            };
+            const auto stale = std::find_if(tested.begin(), tested.end(), movedToNull);
+            const auto weakest = stale != tested.end() ? stale
+                                                       : std::min_element(tested.begin(), tested.end(), [](const Without& a, const Without& b) { return a.share < b.share; });
             auto record = [&](const Without& w, const std::string& verdict) {
                 Trial t;
                 t.round = round;
@@ -363,11 +390,12 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 t.verdict = verdict;
                 d.trials.push_back(t);
             };
-            if (weakest == tested.end() || weakest->share >= o.namingThreshold) {
+            if (weakest == tested.end() || (stale == tested.end() && weakest->share >= o.namingThreshold)) {
                 for (const Without& w : tested) record(w, "kept beside " + best->c.effect + ": without it the validation error rises by the share shown");
                 break;
             }
-            record(*weakest, "dropped: beside " + best->c.effect + " it no longer lowers the validation error by the threshold");
+            record(*weakest, stale != tested.end() ? "dropped: beside " + best->c.effect + " its parameter moved to where its interval reaches the no-effect value"
+                                                   : "dropped: beside " + best->c.effect + " it no longer lowers the validation error by the threshold");
             d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == weakest->effect; }),
                              d.findings.end());
             dropped.insert(weakest->effect);
