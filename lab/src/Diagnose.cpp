@@ -367,16 +367,10 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             }
             // An earlier finding whose parameter the joint refit moved to where its interval (the
             // half-width it was named with) reaches the no-effect value fails rule 4 now.
-            auto movedToNull = [&](const Without& w) {
-                for (const auto& f : d.findings)
-                    if (f.effect == w.effect)
-                        for (const auto& [name, v] : f.parameters) {
-                            const double half = 0.5 * (v[2] - v[1]), now = current.params.at(name);
-                            if (intervalAtNull(name, now - half, now + half)) return true;
-                        }
-                return false;
-            };
-            const auto stale = std::find_if(tested.begin(), tested.end(), movedToNull);
+            const auto stale = std::find_if(tested.begin(), tested.end(), [&](const Without& w) {
+                return std::any_of(d.findings.begin(), d.findings.end(),
+                                   [&](const Finding& f) { return f.effect == w.effect && movedToNull(f, current.params); });
+            });
             const auto weakest = stale != tested.end() ? stale
                                                        : std::min_element(tested.begin(), tested.end(), [](const Without& a, const Without& b) { return a.share < b.share; });
             auto record = [&](const Without& w, const std::string& verdict) {

@@ -273,6 +273,17 @@ bool intervalAtNull(const std::string& name, double lo, double hi)
     return false;
 }
 
+bool movedToNull(const Finding& f, const std::map<std::string, double>& now)
+{
+    for (const auto& [name, v] : f.parameters) {
+        const auto at = now.find(name);
+        if (at == now.end() || v.size() < 3) continue;
+        const double half = 0.5 * (v[2] - v[1]);
+        if (intervalAtNull(name, at->second - half, at->second + half)) return true;
+    }
+    return false;
+}
+
 std::vector<bool> upperDriveHalf(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes)
 {
     std::map<GestureKind, std::vector<double>> drives;

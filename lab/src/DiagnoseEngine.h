@@ -140,6 +140,10 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
 std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after, int B, std::uint64_t seed);
 /// True when [lo, hi] reaches the parameter's no-effect value.
 bool intervalAtNull(const std::string& name, double lo, double hi);
+/// Rule 4 asked again of an earlier finding after a later joint refit moved its parameters to
+/// `now`: does the interval it was named with (the same half-width around the new value) reach
+/// the no-effect value?
+bool movedToNull(const Finding& f, const std::map<std::string, double>& now);
 /// The strokes of `from` in the upper (or lower) half of their gesture's drive (bow acceleration
 /// for Guettler strokes); the median is taken per gesture kind, so a mixed set splits evenly.
 /// (Halves by force would take away the lever arm a load exponent is measured on.)

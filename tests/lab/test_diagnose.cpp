@@ -142,6 +142,30 @@ TEST(DiagnoseSystematic, TheGaussNewtonMoveUndoesALinearChangeAndLeavesFlatDirec
     EXPECT_LT(diag::gaussNewtonShift(J, orthogonal).norm(), 1e-12);
 }
 
+// Rule 4 asked again after a later round's joint refit moved an earlier finding: a shift named at
+// 11 K with +-5 K that moved to 1.8 K now reaches 0 K; one that moved to 9 K does not. A load
+// exponent named at 0.70 +-0.06 reaches 1 at 0.95, not at 0.90. Thermal memory has no no-effect
+// value, and a parameter the refit did not report is not judged.
+TEST(DiagnoseParameters, AnEarlierFindingMovedTowardNoEffectIsJudgedByTheIntervalItWasNamedWith)
+{
+    Finding shift;
+    shift.effect = "rosin_temperature_shift";
+    shift.parameters["shift_k"] = {11.0, 6.0, 16.0};
+    EXPECT_TRUE(diag::movedToNull(shift, {{"shift_k", 1.8}, {"r_A", 0.9}}));
+    EXPECT_FALSE(diag::movedToNull(shift, {{"shift_k", 9.0}, {"r_A", 0.9}}));
+    EXPECT_TRUE(diag::movedToNull(shift, {{"shift_k", -3.0}}));
+    EXPECT_FALSE(diag::movedToNull(shift, {{"r_A", 0.9}}));
+    Finding contact;
+    contact.effect = "hertzian_contact";
+    contact.parameters["load_exponent"] = {0.70, 0.64, 0.76};
+    EXPECT_TRUE(diag::movedToNull(contact, {{"load_exponent", 0.95}}));
+    EXPECT_FALSE(diag::movedToNull(contact, {{"load_exponent", 0.90}}));
+    Finding thermal;
+    thermal.effect = "thermal_memory";
+    thermal.parameters["r_A"] = {1.0, 0.8, 1.2};
+    EXPECT_FALSE(diag::movedToNull(thermal, {{"r_A", 0.01}}));
+}
+
 // A bootstrap resample repeats strokes; the engine simulates each distinct stroke once and scores
 // it as often as it appears. The scores must be those of the strokes taken one at a time, in the
 // resample's order, for the error parts and the signed residuals alike.
