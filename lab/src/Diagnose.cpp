@@ -93,12 +93,10 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     Diagnosis d;
     d.setName = set.folder.string();
     d.warnings = set.warnings;
-    // The string: the manifest, completed from a preset of the same name or the cello D.
-    const dsp::StringParams ref = dsp::StringParams::celloD();
-    StringInfo info{set.f0, set.beta, 0, set.tension.value_or(ref.tension), set.length.value_or(ref.length)};
+    // The string: the manifest, completed from the cello D.
+    const StringInfo info = stringInfoOf(set);
     if (!set.tension) d.warnings.push_back("rig.string.tension_n missing: assumed " + std::to_string(info.tension) + " N (cello D)");
     if (!set.length) d.warnings.push_back("rig.string.length_m missing: assumed " + std::to_string(info.length) + " m (cello D)");
-    info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
 
     // 1. Clean every recording, find its gesture start, convert the set to newtons.
     say("preparing", 0.0);

@@ -166,6 +166,14 @@ SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts)
     return out;
 }
 
+StringInfo stringInfoOf(const MeasurementSet& set)
+{
+    const dsp::StringParams ref = dsp::StringParams::celloD();
+    StringInfo info{set.f0, set.beta, 0, set.tension.value_or(ref.tension), set.length.value_or(ref.length)};
+    info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
+    return info;
+}
+
 std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo& info, const DiagnoseOptions& o, Diagnosis& d)
 {
     // 1. Clean every recording and find its gesture start; one gain for the whole set.

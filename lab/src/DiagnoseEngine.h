@@ -70,6 +70,9 @@ std::string describe(const std::string& effect, const std::vector<ErrorParts>& b
 /// Step 1 of a diagnosis: every recording low-passed, cleaned (DC always; mains hum where most
 /// recordings show it), its gesture start found from the pre-slip ramp, one scale for the set;
 /// what was taken out goes into d.calibration, what had to be assumed into d.warnings.
+/// The set's string: the manifest, completed from the cello D where it is silent (tension, length),
+/// Z0 from them when the manifest does not give it.
+StringInfo stringInfoOf(const MeasurementSet& set);
 std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo& info, const DiagnoseOptions& o, Diagnosis& d);
 
 /// What a lab never knows exactly and diagnosis fits as calibration, not as a finding.

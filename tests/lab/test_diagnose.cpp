@@ -33,24 +33,30 @@ struct Case {
     bool torsionMayHide = false; ///< the long run: a set with torsion may name less, never more
 };
 
-/// The case's 8x8 model-made set, written to disk, read back and diagnosed as the CLI would.
-Diagnosis diagnoseModelSet(const Case& k, SynthTruth& truth)
+/// A model-made set, written to disk and read back as the CLI would read it.
+MeasurementSet modelSetFromDisk(const SynthSpec& spec, SynthTruth& truth)
 {
-    const fs::path dir = fs::temp_directory_path() / ("rosin-diag-" + std::to_string(::getpid()) + "-" + std::to_string(k.seed));
+    const fs::path dir = fs::temp_directory_path() / ("rosin-diag-" + std::to_string(::getpid()) + "-" + std::to_string(spec.seed));
     fs::remove_all(dir);
     fs::create_directories(dir);
+    writeMeasurementSet(dir / "set", synthesize(spec, truth), SF_FORMAT_PCM_24);
+    MeasurementSet set = readMeasurementSet(dir / "set");
+    fs::remove_all(dir);
+    return set;
+}
+
+/// The case's 8x8 model-made set, from disk, diagnosed as the CLI would.
+Diagnosis diagnoseModelSet(const Case& k, SynthTruth& truth)
+{
     SynthSpec spec;
     spec.effects = k.effects;
     spec.seed = k.seed;
     spec.grid = 8;
     spec.outRate = k.rate;
     spec.gaussianReflections = k.gaussian;
-    writeMeasurementSet(dir / "set", synthesize(spec, truth), SF_FORMAT_PCM_24);
     DiagnoseOptions o;
     o.seed = 5;
-    Diagnosis d = diagnose(readMeasurementSet(dir / "set"), o);
-    fs::remove_all(dir);
-    return d;
+    return diagnose(modelSetFromDisk(spec, truth), o);
 }
 
 void check(const Case& k)
@@ -171,20 +177,13 @@ TEST(DiagnoseParameters, AnEarlierFindingMovedTowardNoEffectIsJudgedByTheInterva
 // resample's order, for the error parts and the signed residuals alike.
 TEST(DiagnoseSystematic, ARepeatedStrokeIsSimulatedOnceAndScoredAsOftenAsItAppears)
 {
-    const fs::path dir = fs::temp_directory_path() / ("rosin-diag-repeat-" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
     SynthSpec spec;
     spec.effects = {"thermal_memory"};
     spec.seed = 31;
     spec.grid = 4;
     SynthTruth truth;
-    writeMeasurementSet(dir / "set", synthesize(spec, truth), SF_FORMAT_PCM_24);
-    const MeasurementSet set = readMeasurementSet(dir / "set");
-    fs::remove_all(dir);
-    const rosin::dsp::StringParams ref = rosin::dsp::StringParams::celloD();
-    diag::StringInfo info{set.f0, set.beta, 0, set.tension.value_or(ref.tension), set.length.value_or(ref.length)};
-    info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
+    const MeasurementSet set = modelSetFromDisk(spec, truth);
+    const diag::StringInfo info = diag::stringInfoOf(set);
     DiagnoseOptions o;
     Diagnosis d;
     std::vector<diag::Prepared> strokes = diag::prepareStrokes(set, info, o, d);
