@@ -154,7 +154,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                "An effect is fitted on the fit strokes and named only when (1) its validation-error fall is the largest of the round "
                "with a 95 % paired-bootstrap interval above 0, (2) the fall is at least " + std::to_string(static_cast<int>(std::lround(100 * o.namingThreshold))) +
                    " % of the validation error (threshold calibrated on null sets), and a candidate that brings thermal memory along "
-                   "(rate dependence, a rosin shift) also falls below thermal memory alone by that share, (3) it also lowers the error of the test strokes, "
+                   "(rate dependence, a rosin shift) also falls below thermal memory alone by that share, and a rate dependence or a rosin shift also below the other of the two, "
+                   "fitted in the same round, by that share (else the data do not tell them apart), (3) it also lowers the error of the test strokes, "
                    "(4) the 95 % interval of its parameter (bootstrap refits) excludes the no-effect value (exponent 1, shift 0 K, "
                    "Z_t/Z_0 >= 7.5, speed exponent <= 0.03), and (5) refitted on the low- and on the high-drive half of the fit strokes "
                    "(bow acceleration; v0/tv for exp_speed and bow speed for exp_force strokes, each gesture split at its own median) it keeps away from the no-effect value with consistent values. Every candidate is fitted with the nuisances and the "
@@ -233,6 +234,21 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                     trial.overThermal = base > 0 ? (base - mean(t.val)) / base : 0.0;
                     if (trial.overThermal < o.namingThreshold) {
                         trial.verdict = "no better than thermal_memory alone";
+                        continue;
+                    }
+                }
+            }
+            // A rate dependence and a rosin shift are the two ways the thermal law can bend, and on
+            // Guettler strokes each can take up much of the other (a shift of +20 K stands in for a
+            // rate law): one is named only when it beats the other, fitted in the same round, by
+            // the threshold, whatever the other's own verdict. Otherwise the data do not say which.
+            if (needsThermal(t.c.effect)) {
+                const auto rival = std::find_if(tried.begin(), tried.end(), [&](const Tried& u) { return u.c.effect != t.c.effect && needsThermal(u.c.effect); });
+                if (rival != tried.end()) {
+                    const double base = mean(rival->val);
+                    trial.overRival = base > 0 ? (base - mean(t.val)) / base : 0.0;
+                    if (trial.overRival < o.namingThreshold) {
+                        trial.verdict = "no better than " + rival->c.effect + " (the data do not tell the two apart)";
                         continue;
                     }
                 }

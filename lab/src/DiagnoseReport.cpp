@@ -275,7 +275,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     for (const auto& t : d.trials)
         trials.push_back({{"round", t.round}, {"effect", t.effect}, {"parameters", t.parameters}, {"validation_fall", t.gain},
                           {"validation_fall_ci95", {t.gainLow, t.gainHigh}}, {"relative", t.relativeGain}, {"test_fall", t.testGain},
-                          {"relative_over_thermal_alone", t.overThermal}, {"verdict", t.verdict}});
+                          {"relative_over_thermal_alone", t.overThermal}, {"relative_over_rival", t.overRival}, {"verdict", t.verdict}});
     const json doc{
         {"format", "rosin-diagnosis/1"},
         {"set", d.setName},

@@ -106,7 +106,15 @@ void expectDiagnosis(const Outcome& o)
 // Rate dependence on a thermal rig: named with its exponent p, and h0 reported as not identified.
 TEST(DiagnoseReference, FindsRateDependenceAndSaysH0IsNotIdentified)
 {
-    expectDiagnosis(run({"rate_dependence"}, {{"r_A", 1.0}, {"h0", 0.6}, {"p", 0.45}}, 61));
+    const Outcome o = run({"rate_dependence"}, {{"r_A", 1.0}, {"h0", 0.6}, {"p", 0.45}}, 61);
+    expectDiagnosis(o);
+    // A rosin shift can stand in for a rate law: the rate dependence is named because it beat the
+    // round's shift by the naming threshold, and the shift of that round was not named.
+    const auto named = std::find_if(o.d.trials.begin(), o.d.trials.end(), [](const Trial& t) { return t.effect == "rate_dependence" && t.verdict == "named"; });
+    ASSERT_NE(named, o.d.trials.end());
+    EXPECT_GE(named->overRival, DiagnoseOptions{}.namingThreshold);
+    for (const auto& t : o.d.trials)
+        if (t.effect == "rosin_temperature_shift" && t.round == named->round) EXPECT_NE(t.verdict, "named");
 }
 
 TEST(DiagnoseReference, NamesNothingOnANullRig)

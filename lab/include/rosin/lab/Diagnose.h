@@ -129,6 +129,7 @@ struct Trial {
     double relativeGain = 0;   ///< gain / validation error before
     double testGain = 0;       ///< the same fall on the test strokes (judged for the kept one only)
     double overThermal = 0;    ///< for a candidate that brings thermal memory along: its fall below thermal memory alone, relative
+    double overRival = 0;      ///< for a rate dependence or a rosin shift: its fall below the other of the two fitted in the same round, relative
     std::string verdict;       ///< "named", or which rule it failed
     bool kept = false;
 };
