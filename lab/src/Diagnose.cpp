@@ -25,6 +25,8 @@ namespace {
 /// A fitted parameter closer than this share of its search range to either end is pinned there.
 constexpr double kEdgeShare = 0.01;
 bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
+/// How far `after` lies below `before`, as a share of `before` (0 when there is nothing to fall from).
+double relativeFall(double before, double after) { return before > 0 ? (before - after) / before : 0.0; }
 } // namespace
 
 std::string EffectModel::name() const
@@ -230,8 +232,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             if (needsThermal(t.c.effect) && has(t.c.adds, "thermal_memory")) {
                 const auto alone = std::find_if(tried.begin(), tried.end(), [](const Tried& u) { return u.c.effect == "thermal_memory"; });
                 if (alone != tried.end()) {
-                    const double base = mean(alone->val);
-                    trial.overThermal = base > 0 ? (base - mean(t.val)) / base : 0.0;
+                    trial.overThermal = relativeFall(mean(alone->val), mean(t.val));
                     if (trial.overThermal < o.namingThreshold) {
                         trial.verdict = "no better than thermal_memory alone";
                         continue;
@@ -245,8 +246,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             if (needsThermal(t.c.effect)) {
                 const auto rival = std::find_if(tried.begin(), tried.end(), [&](const Tried& u) { return u.c.effect != t.c.effect && needsThermal(u.c.effect); });
                 if (rival != tried.end()) {
-                    const double base = mean(rival->val);
-                    trial.overRival = base > 0 ? (base - mean(t.val)) / base : 0.0;
+                    trial.overRival = relativeFall(mean(rival->val), mean(t.val));
                     if (trial.overRival < o.namingThreshold) {
                         trial.verdict = "no better than " + rival->c.effect + " (the data do not tell the two apart)";
                         continue;
@@ -375,8 +375,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 const Candidate c = withNuisances(*winner, before);
                 Without w{effect, apply(before, c, diag::fit(engine, before, c, fitSet, c.start, o.maxEvaluations, 0.2)), {}, 0.0};
                 w.val = engine.errors(w.model, valSet);
-                const double e = mean(w.val);
-                w.share = e > 0 ? (e - mean(currentVal)) / e : 0.0;
+                w.share = relativeFall(mean(w.val), mean(currentVal));
                 tested.push_back(std::move(w));
             }
             // An earlier finding whose parameter the joint refit moved to where its interval (the
