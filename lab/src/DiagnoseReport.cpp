@@ -421,7 +421,9 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
           "interval spans both and the refits on the low- and high-drive halves (a parameter that depends on which strokes it is fitted "
           "to carries model mismatch the resamples do not show), then adds in quadrature, side by side, the moves the rig unknowns "
           "cause (contact radius 150 and 350 um, torsion at Z_t/Z_0 = 2: the Gauss-Newton move on the signed metric parts) and the "
-          "model discrepancy that a study of reference sets measured (standard deviations:" << discrepancyText(o) << "). The floor is the "
+          "model discrepancy that a study of reference sets measured (standard deviations:" << discrepancyText(o) << "). That interval is "
+          "how well the size is known; whether an effect is there at all is rule (4)'s, on the bootstrap refits, so a named shift "
+          "of a few kelvin can carry a reported interval that reaches 0 K. The floor is the "
           "final model against itself with 1 % scatter of force and acceleration on the test strokes. "
        << d.simulations << " simulations in " << fmt(d.seconds, "%.1f") << " s.\n";
     for (const auto& w : d.warnings) md << "\nWarning: " << w << "\n";

@@ -426,6 +426,9 @@ std::string scoreStudy(const fs::path& dir)
         const double sd = std::sqrt(std::max(0.0, e.first / e.second));
         md << " " << p << fmt(" %.3g", sd) << " (" << e.second << " sets);";
         summary["model_discrepancy"][p] = sd;
+        // The raw moments too, so that studies of several seeds pool exactly:
+        // sd = sqrt(sum of excess_sum / sum of sets), clipped at 0 only once.
+        summary["model_discrepancy_moments"][p] = {{"excess_sum", e.first}, {"sets", e.second}};
     }
     md << "\n";
     summary["coverage_statistical"] = intervals ? static_cast<double>(coveredStatistical) / intervals : 0.0;

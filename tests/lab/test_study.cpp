@@ -350,6 +350,8 @@ TEST(Study, CountsCoverageByPartAndMeasuresTheModelDiscrepancy)
     // misses of -0.1, +0.02 and +0.2 against standard deviations of (0.02 + hypot(0.08, 0.07)),
     // 2 hypot(0.05, 0.01) and 0.1, each over 2 x 1.96: sqrt(mean(miss^2 - sd^2)) = 0.1265
     EXPECT_NEAR(s["model_discrepancy"]["r_A"].get<double>(), 0.1265, 0.0005);
+    EXPECT_EQ(s["model_discrepancy_moments"]["r_A"]["sets"].get<int>(), 3);
+    EXPECT_NEAR(s["model_discrepancy_moments"]["r_A"]["excess_sum"].get<double>(), 3.0 * 0.1265 * 0.1265, 0.0002);
     EXPECT_NE(md.find("Model discrepancy this study measures"), std::string::npos) << md;
     EXPECT_NE(md.find("r_A 0.127 (3 sets)"), std::string::npos) << md;
     fs::remove_all(dir);

@@ -27,6 +27,18 @@ namespace rosin::cli {
 
 namespace {
 
+/// "r_A=0.064, p=0.073, ...": the shipped defaults, so the help never goes stale.
+std::string defaultDiscrepancyText()
+{
+    std::string text;
+    for (const auto& [name, sd] : DiagnoseOptions{}.modelDiscrepancy) {
+        char value[32];
+        std::snprintf(value, sizeof value, "%g", sd);
+        text += (text.empty() ? "" : ", ") + name + "=" + value;
+    }
+    return text;
+}
+
 /// Options of `rosin diagnose` (bound by add()) and what runs when it is chosen.
 struct DiagnoseCommand {
     std::string diagSet, diagOut = "diagnosis";
@@ -47,8 +59,8 @@ struct DiagnoseCommand {
         diagnoseCmd->add_option("--naming-threshold", diagOptions.namingThreshold, "Least validation-error fall (share) of a named effect")->check(finiteIn(0, 1))->capture_default_str();
         diagnoseCmd->add_option("--residual-factor", diagOptions.residualFactor, "Final error above this many floors: unexplained residual")->check(finiteIn(1, 100))->capture_default_str();
         diagnoseCmd->add_option("--model-discrepancy", discrepancy,
-                                "NAME=SD: the model's own error for parameter NAME (r_A relative, others absolute; 0 = none), "
-                                "instead of the study-calibrated default (r_A=0.064, p=0.065)");
+                                "NAME=SD: the model's own error for parameter NAME (r_A and zt_ratio relative, others absolute; 0 = none), "
+                                "instead of the study-calibrated default (" + defaultDiscrepancyText() + ")");
         diagnoseCmd->add_flag("!--no-nuisances", diagOptions.fitNuisances, "Do not fit tension, bow position and the bow side's thermal effusivity as calibration");
         diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
         return diagnoseCmd;
