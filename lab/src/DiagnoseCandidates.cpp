@@ -284,6 +284,16 @@ bool movedToNull(const Finding& f, const std::map<std::string, double>& now)
     return false;
 }
 
+bool shiftFlippedBesideRateLaw(const std::vector<Trial>& trials, double shiftNow, double least)
+{
+    for (const Trial& t : trials)
+        if (t.round == 1 && t.effect == "rosin_temperature_shift" && t.parameters.count("shift_k")) {
+            const double first = t.parameters.at("shift_k");
+            return std::abs(first) >= least && first * shiftNow < 0.0;
+        }
+    return false;
+}
+
 std::vector<bool> upperDriveHalf(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes)
 {
     std::map<GestureKind, std::vector<double>> drives;

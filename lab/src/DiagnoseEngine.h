@@ -147,6 +147,10 @@ bool intervalAtNull(const std::string& name, double lo, double hi);
 /// `now`: does the interval it was named with (the same half-width around the new value) reach
 /// the no-effect value?
 bool movedToNull(const Finding& f, const std::map<std::string, double>& now);
+/// A rosin shift fitted beside a named rate law, `shiftNow`, against round 1's shift candidate
+/// (fitted before any rate law): true when round 1 asked for at least `least` kelvin of one sign
+/// and the shift now has the other. Round 1's `trials` give that candidate; none, no flip.
+bool shiftFlippedBesideRateLaw(const std::vector<Trial>& trials, double shiftNow, double least = 10.0);
 /// The strokes of `from` in the upper (or lower) half of their gesture's drive (bow acceleration
 /// for Guettler strokes); the median is taken per gesture kind, so a mixed set splits evenly.
 /// (Halves by force would take away the lever arm a load exponent is measured on.)

@@ -113,10 +113,11 @@ void check(const Case& k)
             // zt_ratio, an absolute standard deviation for the others (h0 carries none)
             const std::map<std::string, double> halfwidth{{"r_A", 1.96 * 0.064 * std::abs(v[0])}, {"zt_ratio", 1.96 * 0.53 * std::abs(v[0])},
                                                           {"p", 1.96 * 0.073}, {"load_exponent", 1.96 * 0.018}, {"shift_k", 1.96 * 8.0}};
-            if (halfwidth.count(name))
+            if (halfwidth.count(name)) {
                 EXPECT_NEAR(f.discrepancy.at(name), halfwidth.at(name), 1e-12) << name;
-            else
+            } else {
                 EXPECT_FALSE(f.discrepancy.count(name)) << name;
+            }
         }
     if (!want.empty()) {
         EXPECT_GT(d.gainLow, 0.0) << "held-out gain CI " << d.gainLow << ".." << d.gainHigh;
@@ -176,6 +177,29 @@ TEST(DiagnoseParameters, AnEarlierFindingMovedTowardNoEffectIsJudgedByTheInterva
     thermal.effect = "thermal_memory";
     thermal.parameters["r_A"] = {1.0, 0.8, 1.2};
     EXPECT_FALSE(diag::movedToNull(thermal, {{"r_A", 0.01}}));
+}
+
+// Round 1's shift candidate (before any rate law) against the shift fitted beside a named one:
+// only a sign flip after a round-1 shift of 10 K or more counts.
+TEST(DiagnoseParameters, AShiftThatFlipsSignBesideARateLawIsAStandIn)
+{
+    auto trial = [](int round, const std::string& effect, double shift) {
+        Trial t;
+        t.round = round;
+        t.effect = effect;
+        t.parameters = {{"shift_k", shift}, {"r_A", 1.2}};
+        return t;
+    };
+    const std::vector<Trial> trials{trial(1, "rate_dependence", 0.0), trial(1, "rosin_temperature_shift", 24.0), trial(2, "rosin_temperature_shift", -26.5)};
+    EXPECT_TRUE(diag::shiftFlippedBesideRateLaw(trials, -26.5));
+    EXPECT_TRUE(diag::shiftFlippedBesideRateLaw(trials, -1.0));
+    EXPECT_FALSE(diag::shiftFlippedBesideRateLaw(trials, 8.0)); // same sign: a shift the strokes kept asking for
+    const std::vector<Trial> small{trial(1, "rosin_temperature_shift", 6.2)}; // below 10 K round 1 says little
+    EXPECT_FALSE(diag::shiftFlippedBesideRateLaw(small, -7.5));
+    EXPECT_TRUE(diag::shiftFlippedBesideRateLaw(small, -7.5, 5.0));
+    const std::vector<Trial> negative{trial(1, "rosin_temperature_shift", -13.0)};
+    EXPECT_TRUE(diag::shiftFlippedBesideRateLaw(negative, 11.0));
+    EXPECT_FALSE(diag::shiftFlippedBesideRateLaw({trial(2, "rosin_temperature_shift", 24.0)}, -20.0)); // no round-1 candidate
 }
 
 // A bootstrap resample repeats strokes; the engine simulates each distinct stroke once and scores
@@ -311,8 +335,9 @@ TEST(DiagnoseConsistency, AShiftTheBowsEffusivityCanMimicIsNamedOrShownInTheCali
     for (const auto& f : d.findings) found.push_back(f.effect);
     std::sort(found.begin(), found.end());
     if (found == std::vector<std::string>{"rosin_temperature_shift", "thermal_memory"}) {
-        for (const auto& f : d.findings)
+        for (const auto& f : d.findings) {
             if (f.parameters.count("shift_k")) EXPECT_NEAR(f.parameters.at("shift_k")[0], truth.params.at("shift_k"), 5.0);
+        }
         return;
     }
     ASSERT_EQ(found, std::vector<std::string>{"thermal_memory"});
