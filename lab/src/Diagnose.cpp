@@ -25,8 +25,6 @@ namespace {
 /// A fitted parameter closer than this share of its search range to either end is pinned there.
 constexpr double kEdgeShare = 0.01;
 bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
-/// How far `after` lies below `before`, as a share of `before` (0 when there is nothing to fall from).
-double relativeFall(double before, double after) { return before > 0 ? (before - after) / before : 0.0; }
 } // namespace
 
 std::string EffectModel::name() const
@@ -211,6 +209,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         const Tried* best = nullptr;
         std::map<std::string, double> halfWidth;
         std::map<std::string, std::array<double, 2>> halvesOffset; // the named candidate's halves, from its value
+        std::map<std::string, double> roundValidation;               // every candidate's validation error this round
+        for (const Tried& t : tried) roundValidation[t.c.effect] = mean(t.val);
         for (const Tried& t : tried) {
             Trial& trial = d.trials[t.trial];
             if (!(t.gain[1] > 0.0) || trial.relativeGain < o.namingThreshold) continue;
@@ -224,44 +224,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             for (std::size_t k = 0; k < t.c.scanned; ++k)
                 pinned = pinned || std::min(t.x[k] - t.c.lo[k], t.c.hi[k] - t.x[k]) < kEdgeShare * (t.c.hi[k] - t.c.lo[k]);
             if (pinned) { trial.verdict = "fitted at the edge of its search range (a stand-in, not a measurement)"; continue; }
-            // A candidate that brings thermal memory along with its own effect (rate dependence and
-            // a rosin shift exist only in the thermal model) names two things: its own effect must
-            // earn its place against thermal memory alone, fitted in the same round, by the same
-            // threshold, or one extra parameter's small gain would name it beside thermal memory.
-            // (Only the size: significance of the increment on a quarter of an 8x8 set is too much
-            // to ask of a real 14 K shift, and the candidate's whole fall was significant already.)
-            if (needsThermal(t.c.effect) && has(t.c.adds, "thermal_memory")) {
-                const auto alone = std::find_if(tried.begin(), tried.end(), [](const Tried& u) { return u.c.effect == "thermal_memory"; });
-                if (alone != tried.end()) {
-                    trial.overThermal = relativeFall(mean(alone->val), mean(t.val));
-                    if (trial.overThermal < o.namingThreshold) {
-                        trial.verdict = "no better than thermal_memory alone";
-                        continue;
-                    }
-                }
-            }
-            // A rate dependence and a rosin shift are the two ways the thermal law can bend, and on
-            // Guettler strokes each can take up much of the other (a shift of +20 K stands in for a
-            // rate law): one is named only when it beats the other, fitted in the same round, by
-            // the threshold, whatever the other's own verdict. Otherwise the data do not say which.
-            if (needsThermal(t.c.effect)) {
-                const auto rival = std::find_if(tried.begin(), tried.end(), [&](const Tried& u) { return u.c.effect != t.c.effect && needsThermal(u.c.effect); });
-                if (rival != tried.end()) {
-                    trial.overRival = relativeFall(mean(rival->val), mean(t.val));
-                    if (trial.overRival < o.namingThreshold) {
-                        trial.verdict = "no better than " + rival->c.effect + " (the data do not tell the two apart)";
-                        continue;
-                    }
-                }
-            }
-            // Beside a named rate law a shift fits what that law's form leaves, and where round 1
-            // (before the rate law) asked for a shift of the other sign, standing in for the rate
-            // law, the same strokes have asked for both signs: the sign is not theirs to tell.
-            // (Seeds 2038-2041: all seven shifts named so were spurious, -13 to -29 K after round
-            // 1's +13 to +30 K; four sets hiding a true +-12 K shift beside a rate law named none.)
-            if (t.c.effect == "rosin_temperature_shift" && has(current.effects, "rate_dependence") &&
-                shiftFlippedBesideRateLaw(d.trials, fitted.at("shift_k"))) {
-                trial.verdict = "sign flipped beside rate_dependence (round 1 asked for the other sign): a stand-in for the rate law's form";
+            // Rule 2's comparisons with the round's other candidates (docs/diagnosis.md).
+            if (const std::string failed = standInVerdict(trial, t.c, roundValidation, current.effects, d.trials, o.namingThreshold); !failed.empty()) {
+                trial.verdict = failed;
                 continue;
             }
             // (3) the test strokes

@@ -294,6 +294,43 @@ bool shiftFlippedBesideRateLaw(const std::vector<Trial>& trials, double shiftNow
     return false;
 }
 
+double relativeFall(double before, double after) { return before > 0 ? (before - after) / before : 0.0; }
+
+std::string standInVerdict(Trial& trial, const Candidate& c, const std::map<std::string, double>& roundValidation,
+                           const std::vector<std::string>& namedEffects, const std::vector<Trial>& trials, double threshold)
+{
+    if (!needsThermal(c.effect)) return "";
+    const double own = roundValidation.at(c.effect);
+    // A candidate that brings thermal memory along with its own effect (rate dependence and a
+    // rosin shift exist only in the thermal model) names two things: its own effect must earn its
+    // place against thermal memory alone, fitted in the same round, by the same threshold, or one
+    // extra parameter's small gain would name it beside thermal memory. (Only the size:
+    // significance of the increment on a quarter of an 8x8 set is too much to ask of a real 14 K
+    // shift, and the candidate's whole fall was significant already.)
+    if (const auto alone = roundValidation.find("thermal_memory"); has(c.adds, "thermal_memory") && alone != roundValidation.end()) {
+        trial.overThermal = relativeFall(alone->second, own);
+        if (trial.overThermal < threshold) return "no better than thermal_memory alone";
+    }
+    // A rate dependence and a rosin shift are the two ways the thermal law can bend, and on
+    // Guettler strokes each can take up much of the other (a shift of +20 K stands in for a rate
+    // law): one is named only when it beats the other, fitted in the same round, by the
+    // threshold, whatever the other's own verdict. Otherwise the data do not say which.
+    const std::string rival = c.effect == "rate_dependence" ? "rosin_temperature_shift" : "rate_dependence";
+    if (const auto other = roundValidation.find(rival); other != roundValidation.end()) {
+        trial.overRival = relativeFall(other->second, own);
+        if (trial.overRival < threshold) return "no better than " + rival + " (the data do not tell the two apart)";
+    }
+    // Beside a named rate law a shift fits what that law's form leaves, and where round 1 (before
+    // the rate law) asked for a shift of the other sign, standing in for the rate law, the same
+    // strokes have asked for both signs: the sign is not theirs to tell. (Seeds 2038-2041: all
+    // seven shifts named so were spurious, -13 to -29 K after round 1's +13 to +30 K; four sets
+    // hiding a true +-12 K shift beside a rate law named none.)
+    if (c.effect == "rosin_temperature_shift" && has(namedEffects, "rate_dependence") &&
+        shiftFlippedBesideRateLaw(trials, trial.parameters.at("shift_k")))
+        return "sign flipped beside rate_dependence (round 1 asked for the other sign): a stand-in for the rate law's form";
+    return "";
+}
+
 std::vector<bool> upperDriveHalf(const std::vector<std::size_t>& from, const std::vector<Prepared>& strokes)
 {
     std::map<GestureKind, std::vector<double>> drives;

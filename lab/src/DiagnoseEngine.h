@@ -147,6 +147,15 @@ bool intervalAtNull(const std::string& name, double lo, double hi);
 /// `now`: does the interval it was named with (the same half-width around the new value) reach
 /// the no-effect value?
 bool movedToNull(const Finding& f, const std::map<std::string, double>& now);
+/// How far `after` lies below `before`, as a share of `before` (0 when there is nothing to fall from).
+double relativeFall(double before, double after);
+/// Rule 2's comparisons of candidate `c` (fitted as `trial`) with the round's other candidates,
+/// whose validation errors `roundValidation` holds by effect: one that brings thermal memory along
+/// must fall below thermal memory alone, and a rate dependence or a rosin shift below the other,
+/// each by `threshold` (the shares go into the trial); a shift beside a named rate law must not
+/// flip round 1's sign. Returns the failed rule's verdict, or "" when the candidate passes.
+std::string standInVerdict(Trial& trial, const Candidate& c, const std::map<std::string, double>& roundValidation,
+                           const std::vector<std::string>& namedEffects, const std::vector<Trial>& trials, double threshold);
 /// A rosin shift fitted beside a named rate law, `shiftNow`, against round 1's shift candidate
 /// (fitted before any rate law): true when round 1 asked for at least `least` kelvin of one sign
 /// and the shift now has the other. Round 1's `trials` give that candidate; none, no flip.

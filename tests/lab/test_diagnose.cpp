@@ -202,6 +202,60 @@ TEST(DiagnoseParameters, AShiftThatFlipsSignBesideARateLawIsAStandIn)
     EXPECT_FALSE(diag::shiftFlippedBesideRateLaw({trial(2, "rosin_temperature_shift", 24.0)}, -20.0)); // no round-1 candidate
 }
 
+// Rule 2's comparisons with the round's other candidates, in their order, with the shares written
+// into the trial.
+TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneAndWithEachOther)
+{
+    diag::Candidate shift;
+    shift.effect = "rosin_temperature_shift";
+    shift.adds = {"rosin_temperature_shift", "thermal_memory"};
+    diag::Candidate rate = shift;
+    rate.effect = "rate_dependence";
+    rate.adds = {"rate_dependence", "thermal_memory"};
+    auto trialOf = [](const std::string& effect, double shiftK) {
+        Trial t;
+        t.round = 2;
+        t.effect = effect;
+        t.parameters = {{"shift_k", shiftK}};
+        return t;
+    };
+    // 0.20 alone, 0.18 with a shift: 10 % better; the rate law at 0.185: 2.7 % behind the shift
+    Trial t = trialOf("rosin_temperature_shift", 12.0);
+    EXPECT_EQ(diag::standInVerdict(t, shift, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.18}, {"rate_dependence", 0.185}}, {}, {}, 0.05),
+              "no better than rate_dependence (the data do not tell the two apart)");
+    EXPECT_NEAR(t.overThermal, 0.10, 1e-12);
+    EXPECT_NEAR(t.overRival, 0.005 / 0.185, 1e-12);
+    // 0.191 with the shift is 4.5 % under 0.20 alone: the thermal rule fails first, the rival is not judged
+    t = trialOf("rosin_temperature_shift", 12.0);
+    EXPECT_EQ(diag::standInVerdict(t, shift, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.191}, {"rate_dependence", 0.30}}, {}, {}, 0.05),
+              "no better than thermal_memory alone");
+    EXPECT_EQ(t.overRival, 0.0);
+    // the rate law well ahead of both: passes, and its shares are recorded
+    Trial r = trialOf("rate_dependence", 0.0);
+    EXPECT_EQ(diag::standInVerdict(r, rate, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.18}, {"rate_dependence", 0.10}}, {}, {}, 0.05), "");
+    EXPECT_NEAR(r.overThermal, 0.5, 1e-12);
+    EXPECT_NEAR(r.overRival, 0.08 / 0.18, 1e-12);
+    // beside a named rate law (no rate candidate this round) a shift that flipped round 1's sign fails
+    const std::vector<Trial> earlier{[] {
+        Trial first;
+        first.round = 1;
+        first.effect = "rosin_temperature_shift";
+        first.parameters = {{"shift_k", 24.0}};
+        return first;
+    }()};
+    const std::map<std::string, double> besideRate{{"rosin_temperature_shift", 0.10}};
+    t = trialOf("rosin_temperature_shift", -26.5);
+    EXPECT_EQ(diag::standInVerdict(t, shift, besideRate, {"thermal_memory", "rate_dependence"}, earlier, 0.05),
+              "sign flipped beside rate_dependence (round 1 asked for the other sign): a stand-in for the rate law's form");
+    t = trialOf("rosin_temperature_shift", -26.5);
+    EXPECT_EQ(diag::standInVerdict(t, shift, besideRate, {"thermal_memory"}, earlier, 0.05), "");
+    // a contact or torsion is not compared with anything here
+    diag::Candidate contact;
+    contact.effect = "hertzian_contact";
+    t = trialOf("hertzian_contact", 0.0);
+    EXPECT_EQ(diag::standInVerdict(t, contact, {{"hertzian_contact", 0.5}, {"thermal_memory", 0.1}}, {}, {}, 0.05), "");
+}
+
 // A bootstrap resample repeats strokes; the engine simulates each distinct stroke once and scores
 // it as often as it appears. The scores must be those of the strokes taken one at a time, in the
 // resample's order, for the error parts and the signed residuals alike.
@@ -336,7 +390,9 @@ TEST(DiagnoseConsistency, AShiftTheBowsEffusivityCanMimicIsNamedOrShownInTheCali
     std::sort(found.begin(), found.end());
     if (found == std::vector<std::string>{"rosin_temperature_shift", "thermal_memory"}) {
         for (const auto& f : d.findings) {
-            if (f.parameters.count("shift_k")) EXPECT_NEAR(f.parameters.at("shift_k")[0], truth.params.at("shift_k"), 5.0);
+            if (f.parameters.count("shift_k")) {
+                EXPECT_NEAR(f.parameters.at("shift_k")[0], truth.params.at("shift_k"), 5.0);
+            }
         }
         return;
     }
