@@ -145,13 +145,16 @@ void drawFigure(const fs::path& file, const std::vector<Scored>& sets)
 std::vector<StudySet> planStudy(const StudyOptions& o)
 {
     if (o.sets < 1 || o.nulls < 0 || o.nulls > o.sets) throw LabError("study: need 0 <= nulls <= sets and at least one set");
+    if (o.plan != 1 && o.plan != 2) throw LabError("study --plan: " + std::to_string(o.plan) + " is not a plan version (1 or 2)");
     std::mt19937_64 rng(o.seed);
     const std::vector<std::vector<std::string>> singles{{"thermal_memory"}, {"rate_dependence"}, {"hertzian_contact"},
                                                         {"rosin_temperature_shift"}, {"torsional_compliance"}};
-    const std::vector<std::vector<std::string>> doubles{{"thermal_memory", "hertzian_contact"},       {"hertzian_contact", "torsional_compliance"},
+    std::vector<std::vector<std::string>> doubles{{"thermal_memory", "hertzian_contact"},       {"hertzian_contact", "torsional_compliance"},
                                                         {"thermal_memory", "torsional_compliance"},   {"rosin_temperature_shift", "hertzian_contact"},
                                                         {"rate_dependence", "torsional_compliance"},  {"rosin_temperature_shift", "torsional_compliance"},
                                                         {"rate_dependence", "hertzian_contact"}};
+    // Version 2: a shift beside a rate law, the pair the diagnosis finds hardest to tell apart.
+    if (o.plan >= 2) doubles.push_back({"rate_dependence", "rosin_temperature_shift"});
     const std::vector<std::vector<std::string>> triples{{"thermal_memory", "hertzian_contact", "torsional_compliance"},
                                                         {"rosin_temperature_shift", "hertzian_contact", "torsional_compliance"},
                                                         {"rate_dependence", "hertzian_contact", "torsional_compliance"}};
@@ -184,6 +187,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     for (const auto& p : plan) planJson.push_back({{"index", p.index}, {"seed", p.seed}, {"effects", p.effects}});
     planJson = json{{"grid", o.grid}, {"seed", o.seed}, {"sets", planJson}};
     if (o.gesture != "guettler") planJson["gesture"] = o.gesture; // Guettler studies' plans stay as they were
+    if (o.plan != 1) planJson["plan"] = o.plan;                    // and so do version-1 plans
     // A folder resumes only the study it holds: sets are skipped by folder name, so a different
     // seed, size or grid would silently mix two studies.
     if (fs::exists(dir / "plan.json")) {
@@ -194,7 +198,8 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
         }
         if (before != planJson)
-            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid or gesture); use a new folder");
+            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture or plan version: a plan.json "
+                                                          "without \"plan\" is version 1, --plan 1); use a new folder");
     }
     fs::create_directories(dir / "sets");
     if (mpi.isRoot() && !fs::exists(dir / "plan.json")) std::ofstream(dir / "plan.json") << planJson.dump(1) << "\n";

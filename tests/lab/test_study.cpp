@@ -94,6 +94,50 @@ TEST(Study, PlanHasTheAskedNullsAndMixOfSinglesDoublesAndTriples)
     EXPECT_GT(differ, 10);
 }
 
+TEST(Study, PlanVersionOneIsThePlanOfTheEarlierStudies)
+{
+    // Seed 2041's study (docs/diagnosis-study.md) was planned before versions existed: version 1
+    // must plan it again set for set, or its kept sets no longer match their plan.
+    StudyOptions o;
+    o.sets = 40;
+    o.nulls = 10;
+    o.seed = 2041;
+    o.plan = 1;
+    const std::vector<StudySet> plan = planStudy(o);
+    const std::vector<std::vector<std::string>> recorded{{"rate_dependence"}, {"rosin_temperature_shift"}, {"thermal_memory", "hertzian_contact"},
+                                                         {},                  {"rosin_temperature_shift"}, {"hertzian_contact"}};
+    for (std::size_t k = 0; k < recorded.size(); ++k) EXPECT_EQ(plan[k].effects, recorded[k]) << "set " << k;
+    EXPECT_EQ(plan[0].seed, 2041001u);
+}
+
+TEST(Study, OnlyPlanVersionTwoHidesARateLawBesideAShift)
+{
+    auto pairs = [](const std::vector<StudySet>& plan) {
+        int n = 0;
+        for (const StudySet& s : plan) {
+            const bool rate = std::find(s.effects.begin(), s.effects.end(), "rate_dependence") != s.effects.end();
+            const bool shift = std::find(s.effects.begin(), s.effects.end(), "rosin_temperature_shift") != s.effects.end();
+            n += rate && shift;
+        }
+        return n;
+    };
+    StudyOptions o;
+    o.sets = 40;
+    o.nulls = 10;
+    for (std::uint64_t seed = 2030; seed < 2045; ++seed) {
+        o.seed = seed;
+        o.plan = 1;
+        EXPECT_EQ(pairs(planStudy(o)), 0) << "seed " << seed;
+        o.plan = 2;
+        // 11 doubles dealt from 9 pairs: every pair once, two of them twice.
+        const int n = pairs(planStudy(o));
+        EXPECT_GE(n, 1) << "seed " << seed;
+        EXPECT_LE(n, 2) << "seed " << seed;
+    }
+    o.plan = 3;
+    EXPECT_THROW(planStudy(o), LabError);
+}
+
 TEST(Study, PlanRefusesMoreNullsThanSets)
 {
     StudyOptions o;
@@ -121,6 +165,20 @@ TEST(Study, AFolderResumesOnlyTheStudyItHolds)
         EXPECT_NE(std::string(e.what()).find("plan.json"), std::string::npos) << e.what();
     }
     EXPECT_FALSE(fs::exists(dir / "sets")) << "nothing is started in a refused folder";
+    // The same study under another plan version is another study too; the error says how to
+    // resume a version-1 folder.
+    StudyOptions version1 = o;
+    version1.plan = 1;
+    plan = json::array();
+    for (const StudySet& s : planStudy(version1)) plan.push_back({{"index", s.index}, {"seed", s.seed}, {"effects", s.effects}});
+    std::ofstream(dir / "plan.json") << json{{"grid", o.grid}, {"seed", o.seed}, {"sets", plan}}.dump(1);
+    try {
+        runStudy(dir, o);
+        FAIL() << "a version-1 folder was resumed as version 2";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("--plan 1"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir / "sets"));
     fs::remove_all(dir);
 }
 

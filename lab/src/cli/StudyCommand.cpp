@@ -31,6 +31,10 @@ struct StudyCommand {
         cmd->add_option("--nulls", options.nulls, "Of which with nothing hidden")->check(CLI::Range(0, 1000))->capture_default_str();
         cmd->add_option("--grid", options.grid, "Strokes per axis of each set")->check(CLI::Range(3, 30))->capture_default_str();
         cmd->add_option("--seed", options.seed, "Seed of the plan and of every set")->capture_default_str();
+        cmd->add_option("--plan", options.plan,
+                        "Plan version: 1 as in studies up to seed 2042, 2 also hides a rate dependence beside a rosin shift")
+            ->check(CLI::Range(1, 2))
+            ->capture_default_str();
         cmd->add_option("--gesture", options.gesture, "Strokes of every set: guettler, exp_speed, exp_force or mixed")
             ->check(CLI::IsMember({"guettler", "exp_speed", "exp_force", "mixed"}))->capture_default_str();
         cmd->add_option("--oversampling", options.oversampling, "Reference simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();

@@ -20,6 +20,10 @@ struct StudyOptions {
     int nulls = 8;             ///< of which with no hidden effect
     int grid = 12;             ///< strokes per axis of each set
     std::uint64_t seed = 1;    ///< the plan, and each set's seed, follow from it
+    /// Which effects a plan can hide together. 1: the plans of every study up to seed 2042,
+    /// where no set hides a rate dependence beside a rosin shift; 2 adds that pair (so the
+    /// diagnosis's rule for a shift beside a rate law meets true shifts too).
+    int plan = 2;
     int oversampling = 4;
     /// The sets' strokes (synth-data --gesture): guettler, exp_speed, exp_force (then
     /// calibrated in newtons: rising-force strokes alone cannot set a volt scale) or mixed.
