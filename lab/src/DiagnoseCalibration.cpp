@@ -270,21 +270,49 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
         if (set.strokes[i].trigger) cal[i].trigger = *set.strokes[i].trigger;
     });
     std::vector<Prepared> strokes(n);
+    std::vector<std::vector<double>> rests(n); // restDifferences() of each stroke
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
         const MeasuredStroke& s = set.strokes[i];
         Prepared& p = strokes[i];
         p.id = s.id;
         p.gesture = strokeGesture(s, info.beta);
-        const auto from = static_cast<std::size_t>(std::max(0.0, cal[i].trigger) * set.sampleRate);
-        std::vector<double> f;
+        const auto from = std::min(cal[i].force.size(), static_cast<std::size_t>(std::max(0.0, cal[i].trigger) * set.sampleRate));
+        std::vector<double> f, rest;
         // Unfitted strokes are in signal units: the set's gain converts them.
         const double toNewtons = cal[i].rampFitted ? cal[i].gain / gain : 1.0 / gain;
+        for (std::size_t k = 0; k < from; ++k) rest.push_back(cal[i].force[k] * toNewtons);
         for (std::size_t k = from; k < cal[i].force.size(); ++k) f.push_back(cal[i].force[k] * toNewtons);
+        rests[i] = restDifferences(resample(rest, set.sampleRate, o.simRate), o.simRate);
         f = resample(f, set.sampleRate, o.simRate);
         f.resize(std::min(f.size(), static_cast<std::size_t>(0.5 * o.simRate)));
         p.force = std::move(f);
         p.noise = noiseLevel(p.force);
-        p.feat = features(p.force, o.simRate, p.gesture, info, true);
+    });
+    // The first-slip detector's floor: the rig's noise is the same in every stroke, so the rests
+    // before the gestures are pooled (a single rest is often only a few ms). Without 10 ms of rest
+    // in the whole set each signal estimates its own, and the report says so.
+    std::vector<double> pooled, single;
+    for (const auto& r : rests) {
+        pooled.insert(pooled.end(), r.begin(), r.end());
+        if (r.size() >= static_cast<std::size_t>(1e-3 * o.simRate)) single.push_back(slipFloorOf(r));
+    }
+    std::optional<double> slipFloor;
+    if (pooled.size() >= static_cast<std::size_t>(1e-2 * o.simRate)) {
+        slipFloor = slipFloorOf(pooled);
+        std::sort(single.begin(), single.end());
+        const bool spread = single.size() >= 5;
+        d.calibration.push_back({"slip_noise_floor_n",
+                                 "least fall within 0.1 ms read as a first slip rather than noise: six standard deviations of the noise's fall, "
+                                 "from the rests before the gestures (pooled); the interval is the range single strokes' rests give",
+                                 *slipFloor, spread ? single[single.size() / 40] : *slipFloor,
+                                 spread ? single[single.size() - 1 - single.size() / 40] : *slipFloor});
+    } else {
+        d.warnings.push_back("less than 10 ms of rest before the gestures in the whole set: the first-slip detector reads each "
+                             "stroke's noise from the stroke itself, which misses most of a low-passed noise");
+    }
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+        strokes[i].slipFloor = slipFloor;
+        strokes[i].feat = features(strokes[i].force, o.simRate, strokes[i].gesture, info, slipFloor);
     });
 
 

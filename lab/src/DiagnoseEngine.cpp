@@ -34,15 +34,40 @@ double noiseLevel(const std::vector<double>& f)
     return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
 }
 
-StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, bool recorded)
+namespace {
+int dropWindow(double fs) { return std::max(2, static_cast<int>(std::lround(1e-4 * fs))); } // the classifier's 0.1 ms
+} // namespace
+
+std::vector<double> restDifferences(std::vector<double> rest, double fs)
+{
+    const int w = dropWindow(fs);
+    const auto edge = static_cast<std::size_t>(std::lround(1e-3 * fs)) + static_cast<std::size_t>(2 * w); // the filter's settling at both ends
+    if (rest.size() < 2 * edge + static_cast<std::size_t>(std::lround(1e-3 * fs))) return {};
+    zeroPhaseLowPass(rest, kCompareCutoff, fs);
+    std::vector<double> d;
+    for (std::size_t i = edge; i + edge < rest.size(); ++i) d.push_back(rest[i - w] - 2.0 * rest[i] + rest[i + w]);
+    return d;
+}
+
+double slipFloorOf(std::vector<double> differences)
+{
+    if (differences.empty()) return 0.0;
+    for (double& x : differences) x = std::abs(x);
+    return 6.0 * 1.4826 * median(std::move(differences)) / std::sqrt(3.0);
+}
+
+StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, std::optional<double> slipFloor)
 {
     zeroPhaseLowPass(f, kCompareCutoff, fs);
     const ClassifierInput in = strokeInput(f, fs, g, s);
     const double F = g.force; // the final force of a rising-force stroke
     ClassifierSettings st;
     // A first slip drops the force by more than 2 % of the bow force, and in a recording by
-    // clearly more than its noise can within 0.1 ms.
-    st.slipFloor = std::max(0.02 * F, recorded ? 6.0 * noiseLevel(f) : 0.0);
+    // clearly more than its noise can within 0.1 ms. The noise is best read where there is
+    // nothing else: the rest before the gesture (slipFloor). Read from the stroke itself, lag-1
+    // differences of the low-passed signal see little of it, and noise alone then fires
+    // "first slips" at a quarter of the bow force.
+    st.slipFloor = std::max(0.02 * F, slipFloor ? *slipFloor : 6.0 * noiseLevel(f));
     // No rosin lets go before the bridge force has reached a quarter of the bow force: an
     // earlier drop is noise or a badly found gesture start, in a recording and a model alike.
     st.minSlipForce = 0.25 * F;
@@ -194,7 +219,7 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
         const std::vector<double>& add = noiseSeed == 0 ? noise_[i] : other;
         for (std::size_t n = 0; n < out.size(); ++n) out[n] += add[n];
     }
-    return features(std::move(out), fs_, p.gesture, info_, true);
+    return features(std::move(out), fs_, p.gesture, info_, p.slipFloor);
 }
 
 namespace {

@@ -30,6 +30,9 @@ struct Prepared {
     Gesture gesture;           ///< as the manifest states it (t = 0 at the gesture start)
     std::vector<double> force; ///< N at the diagnosis rate, t = 0 at the gesture start
     double noise = 0;          ///< rms noise of the recording (N), added to its simulations
+    /// The least drop within 0.1 ms that is a first slip and not the rig's noise (N), for the
+    /// recording and its simulations alike; unset: each signal's own estimate (noiseLevel).
+    std::optional<double> slipFloor;
     StrokeFeatures feat;
 };
 
@@ -40,7 +43,16 @@ constexpr double kCompareCutoff = 5000.0; // both signals see the same low-pass 
 ClassifierInput strokeInput(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s);
 /// Noise of a low-passed recording: the robust spread of its sample-to-sample steps.
 double noiseLevel(const std::vector<double>& f);
-StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, bool recorded = false);
+/// Features of a stroke's force f. A first slip must drop the force within 0.1 ms by 2 % of the bow
+/// force and by `slipFloor` (N); unset, by six times f's own noiseLevel() after the low-pass.
+StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, std::optional<double> slipFloor = std::nullopt);
+/// Lag-0.1 ms second differences of the rest before a gesture (N at rate fs), low-passed as the
+/// comparison is and away from the segment's ends: the rig's noise alone, any drift cancelled.
+/// Empty when the rest is too short (under about 3 ms).
+std::vector<double> restDifferences(std::vector<double> rest, double fs);
+/// Six standard deviations of the fall that noise alone makes over 0.1 ms, from rest differences:
+/// at that lag (the low-pass's first correlation zero) their spread is sqrt(3) times the fall's.
+double slipFloorOf(std::vector<double> differences);
 /// Per-part disagreement of simulated features s with measured m, for a stroke of gesture g: the
 /// waveform is measured against the flyback the bow speed at the measured first slip would give.
 ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info);

@@ -15,6 +15,7 @@
 #include "rosin/dsp.h"
 #include "rosin/lab/Diagnose.h"
 #include "rosin/lab/Measurement.h"
+#include "rosin/lab/Resample.h"
 #include "rosin/lab/SynthData.h"
 
 #include <Eigen/QR>
@@ -259,6 +260,72 @@ TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneA
 // A bootstrap resample repeats strokes; the engine simulates each distinct stroke once and scores
 // it as often as it appears. The scores must be those of the strokes taken one at a time, in the
 // resample's order, for the error parts and the signed residuals alike.
+TEST(DiagnoseNoise, TheSlipFloorIsSixDeviationsOfTheFallNoiseMakesInATenthOfAMillisecond)
+{
+    // White noise at 48 kHz, low-passed as the comparison is: what falls over 0.1 ms is what
+    // the first-slip detector must not take for a slip.
+    const double fs = 48000.0, sigma = 0.01;
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> g(0.0, sigma);
+    std::vector<double> noise(static_cast<std::size_t>(0.2 * fs));
+    for (double& x : noise) x = g(rng);
+    std::vector<double> lowPassed = noise;
+    zeroPhaseLowPass(lowPassed, diag::kCompareCutoff, fs);
+    const int w = 5; // 0.1 ms at 48 kHz
+    double sum = 0, sum2 = 0;
+    int count = 0;
+    for (std::size_t i = 1000; i + w + 1000 < lowPassed.size(); ++i, ++count) {
+        const double fall = lowPassed[i] - lowPassed[i + w];
+        sum += fall;
+        sum2 += fall * fall;
+    }
+    const double fallSd = std::sqrt(sum2 / count - (sum / count) * (sum / count));
+    const double floor = diag::slipFloorOf(diag::restDifferences(noise, fs));
+    EXPECT_NEAR(floor, 6.0 * fallSd, 0.08 * 6.0 * fallSd);
+    // A drift under the noise changes nothing: the differences cancel a ramp.
+    std::vector<double> drifting = noise;
+    for (std::size_t i = 0; i < drifting.size(); ++i) drifting[i] += 2.0 * static_cast<double>(i) / fs;
+    EXPECT_NEAR(diag::slipFloorOf(diag::restDifferences(drifting, fs)), floor, 0.02 * floor);
+    // Read from the low-passed signal itself (the detector's floor before), the noise looks
+    // several times smaller than the falls it makes.
+    EXPECT_LT(6.0 * diag::noiseLevel(lowPassed), 0.4 * floor);
+    // A rest too short to read is no estimate.
+    EXPECT_TRUE(diag::restDifferences(std::vector<double>(100, 0.0), fs).empty());
+}
+
+TEST(DiagnoseNoise, NoiseAloneFiresNoFirstSlipAtLowForce)
+{
+    // A model-made 4x4 set with 0.01 N of white noise (the default): its lowest bow force,
+    // 0.15 N, sticks to about its static friction before the first slip. The recordings'
+    // first slips must be read there, not where a fall of noise first passes 2 % of the force.
+    SynthSpec spec;
+    spec.seed = 12;
+    spec.grid = 4;
+    SynthTruth truth;
+    const MeasurementSet set = modelSetFromDisk(spec, truth);
+    const diag::StringInfo info = diag::stringInfoOf(set);
+    DiagnoseOptions o;
+    Diagnosis d;
+    const std::vector<diag::Prepared> strokes = diag::prepareStrokes(set, info, o, d);
+    const auto floor = std::find_if(d.calibration.begin(), d.calibration.end(), [](const CalibrationValue& c) { return c.name == "slip_noise_floor_n"; });
+    ASSERT_NE(floor, d.calibration.end()) << "the floor is reported as calibration";
+    EXPECT_LE(floor->low, floor->value);
+    EXPECT_GE(floor->high, floor->value);
+    int low = 0, early = 0, earlyBefore = 0;
+    for (const diag::Prepared& p : strokes) {
+        if (p.gesture.force > 0.2) continue;
+        ++low;
+        ASSERT_TRUE(p.slipFloor.has_value());
+        EXPECT_NEAR(*p.slipFloor, floor->value, 1e-12);
+        early += p.feat.firstSlip < 0 || p.feat.forceBeforeSlip < 0.5 * p.gesture.force;
+        const StrokeFeatures before = diag::features(p.force, o.simRate, p.gesture, info); // each signal's own floor
+        earlyBefore += before.firstSlip < 0 || before.forceBeforeSlip < 0.5 * p.gesture.force;
+    }
+    EXPECT_EQ(low, 4);
+    EXPECT_EQ(early, 0) << "a fall of noise read as the first slip";
+    EXPECT_GE(earlyBefore, 2) << "the stroke's own noise estimate, which this floor replaced, fired early here";
+}
+
 TEST(DiagnoseSystematic, ARepeatedStrokeIsSimulatedOnceAndScoredAsOftenAsItAppears)
 {
     SynthSpec spec;
