@@ -275,7 +275,7 @@ Calibration calibrateRecording(const ClassifierInput& in)
     if (n < 16) throw LabError("calibration: the signal is too short");
     for (double x : f)
         if (!std::isfinite(x)) throw LabError("calibration: the signal contains NaN or infinite samples");
-    const int window01 = std::max(2, static_cast<int>(std::lround(1e-4 * fs)));
+    const int window01 = slipDropWindow(fs);
     zeroPhaseLowPass(f, std::min(10000.0, 0.4 * fs), fs);
     // Noise floor from sample-to-sample differences (robust: median absolute deviation).
     std::vector<double> d;
@@ -325,7 +325,7 @@ Classification classify(const ClassifierInput& in, const ClassifierSettings& st)
     if (n < 16) throw LabError("classifier: the signal is too short");
     for (double x : f)
         if (!std::isfinite(x)) throw LabError("classifier: the signal contains NaN or infinite samples");
-    const int window01 = std::max(2, static_cast<int>(std::lround(1e-4 * fs))); // 0.1 ms
+    const int window01 = slipDropWindow(fs);
 
     int slip = -1;
     if (in.measured) {

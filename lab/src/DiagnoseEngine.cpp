@@ -34,13 +34,9 @@ double noiseLevel(const std::vector<double>& f)
     return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
 }
 
-namespace {
-int dropWindow(double fs) { return std::max(2, static_cast<int>(std::lround(1e-4 * fs))); } // the classifier's 0.1 ms
-} // namespace
-
 std::vector<double> restDifferences(std::vector<double> rest, double fs)
 {
-    const int w = dropWindow(fs);
+    const int w = slipDropWindow(fs);
     const auto edge = static_cast<std::size_t>(std::lround(1e-3 * fs)) + static_cast<std::size_t>(2 * w); // the filter's settling at both ends
     if (rest.size() < 2 * edge + static_cast<std::size_t>(std::lround(1e-3 * fs))) return {};
     zeroPhaseLowPass(rest, kCompareCutoff, fs);

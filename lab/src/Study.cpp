@@ -150,9 +150,9 @@ std::vector<StudySet> planStudy(const StudyOptions& o)
     const std::vector<std::vector<std::string>> singles{{"thermal_memory"}, {"rate_dependence"}, {"hertzian_contact"},
                                                         {"rosin_temperature_shift"}, {"torsional_compliance"}};
     std::vector<std::vector<std::string>> doubles{{"thermal_memory", "hertzian_contact"},       {"hertzian_contact", "torsional_compliance"},
-                                                        {"thermal_memory", "torsional_compliance"},   {"rosin_temperature_shift", "hertzian_contact"},
-                                                        {"rate_dependence", "torsional_compliance"},  {"rosin_temperature_shift", "torsional_compliance"},
-                                                        {"rate_dependence", "hertzian_contact"}};
+                                                  {"thermal_memory", "torsional_compliance"},   {"rosin_temperature_shift", "hertzian_contact"},
+                                                  {"rate_dependence", "torsional_compliance"},  {"rosin_temperature_shift", "torsional_compliance"},
+                                                  {"rate_dependence", "hertzian_contact"}};
     // Version 2: a shift beside a rate law, the pair the diagnosis finds hardest to tell apart.
     if (o.plan >= 2) doubles.push_back({"rate_dependence", "rosin_temperature_shift"});
     const std::vector<std::vector<std::string>> triples{{"thermal_memory", "hertzian_contact", "torsional_compliance"},

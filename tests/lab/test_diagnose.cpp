@@ -46,6 +46,19 @@ MeasurementSet modelSetFromDisk(const SynthSpec& spec, SynthTruth& truth)
     return set;
 }
 
+/// A model-made 4x4 set's strokes, prepared as a diagnosis prepares them.
+std::vector<diag::Prepared> preparedModelSet(std::vector<std::string> effects, std::uint64_t seed, diag::StringInfo& info, Diagnosis& d)
+{
+    SynthSpec spec;
+    spec.effects = std::move(effects);
+    spec.seed = seed;
+    spec.grid = 4;
+    SynthTruth truth;
+    const MeasurementSet set = modelSetFromDisk(spec, truth);
+    info = diag::stringInfoOf(set);
+    return diag::prepareStrokes(set, info, DiagnoseOptions{}, d);
+}
+
 /// The case's 8x8 model-made set, from disk, diagnosed as the CLI would.
 Diagnosis diagnoseModelSet(const Case& k, SynthTruth& truth)
 {
@@ -298,15 +311,10 @@ TEST(DiagnoseNoise, NoiseAloneFiresNoFirstSlipAtLowForce)
     // A model-made 4x4 set with 0.01 N of white noise (the default): its lowest bow force,
     // 0.15 N, sticks to about its static friction before the first slip. The recordings'
     // first slips must be read there, not where a fall of noise first passes 2 % of the force.
-    SynthSpec spec;
-    spec.seed = 12;
-    spec.grid = 4;
-    SynthTruth truth;
-    const MeasurementSet set = modelSetFromDisk(spec, truth);
-    const diag::StringInfo info = diag::stringInfoOf(set);
-    DiagnoseOptions o;
+    diag::StringInfo info;
     Diagnosis d;
-    const std::vector<diag::Prepared> strokes = diag::prepareStrokes(set, info, o, d);
+    const std::vector<diag::Prepared> strokes = preparedModelSet({}, 12, info, d);
+    const DiagnoseOptions o;
     const auto floor = std::find_if(d.calibration.begin(), d.calibration.end(), [](const CalibrationValue& c) { return c.name == "slip_noise_floor_n"; });
     ASSERT_NE(floor, d.calibration.end()) << "the floor is reported as calibration";
     EXPECT_LE(floor->low, floor->value);
@@ -328,16 +336,10 @@ TEST(DiagnoseNoise, NoiseAloneFiresNoFirstSlipAtLowForce)
 
 TEST(DiagnoseSystematic, ARepeatedStrokeIsSimulatedOnceAndScoredAsOftenAsItAppears)
 {
-    SynthSpec spec;
-    spec.effects = {"thermal_memory"};
-    spec.seed = 31;
-    spec.grid = 4;
-    SynthTruth truth;
-    const MeasurementSet set = modelSetFromDisk(spec, truth);
-    const diag::StringInfo info = diag::stringInfoOf(set);
-    DiagnoseOptions o;
+    diag::StringInfo info;
     Diagnosis d;
-    std::vector<diag::Prepared> strokes = diag::prepareStrokes(set, info, o, d);
+    std::vector<diag::Prepared> strokes = preparedModelSet({"thermal_memory"}, 31, info, d);
+    const DiagnoseOptions o;
     ASSERT_EQ(strokes.size(), 16u);
     const diag::Engine engine(strokes, info, o.simRate, std::nullopt, false);
     for (const EffectModel& m : {EffectModel{}, EffectModel{{"thermal_memory"}, {{"r_A", 1.1}}}}) {

@@ -3,6 +3,8 @@
 // the regime. For recordings it first removes what rigs add: DC, mains hum, noise, an unknown
 // gain and an unknown trigger time.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -13,6 +15,9 @@ namespace rosin::lab {
 enum class Regime { Helmholtz, SMotion, DoubleSlip, DoubleFlyback, Irregular, NoSlip };
 const char* regimeName(Regime r);
 bool isSuccess(Regime r); ///< Helmholtz or S-motion within the cap
+
+/// Samples in the 0.1 ms a first slip must drop the force within (at least 2).
+inline int slipDropWindow(double sampleRate) { return std::max(2, static_cast<int>(std::lround(1e-4 * sampleRate))); }
 
 struct ClassifierSettings {
     double flybackFraction = 0.35;  ///< gamma: a flyback drops more than gamma * 2 Z0 vb / beta
