@@ -277,11 +277,10 @@ Calibration calibrateRecording(const ClassifierInput& in)
         if (!std::isfinite(x)) throw LabError("calibration: the signal contains NaN or infinite samples");
     const int window01 = slipDropWindow(fs);
     zeroPhaseLowPass(f, std::min(10000.0, 0.4 * fs), fs);
-    // Noise floor from sample-to-sample differences (robust: median absolute deviation).
+    // Noise floor from sample-to-sample differences.
     std::vector<double> d;
-    for (int i = 1; i < n; ++i) d.push_back(std::abs(f[i] - f[i - 1]));
-    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    const double noise = 1.4826 * d[d.size() / 2];
+    for (int i = 1; i < n; ++i) d.push_back(f[i] - f[i - 1]);
+    const double noise = robustSigma(std::move(d));
     std::vector<double> head(f.begin(), f.begin() + std::min(n, static_cast<int>(2e-3 * fs) + 1));
     std::nth_element(head.begin(), head.begin() + head.size() / 2, head.end());
     Calibration out;

@@ -29,9 +29,8 @@ double noiseLevel(const std::vector<double>& f)
     // rms s sqrt(6); the median keeps the flybacks out.
     if (f.size() < 4) return 0.0;
     std::vector<double> d(f.size() - 2);
-    for (std::size_t i = 1; i + 1 < f.size(); ++i) d[i - 1] = std::abs(f[i + 1] - 2.0 * f[i] + f[i - 1]);
-    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
+    for (std::size_t i = 1; i + 1 < f.size(); ++i) d[i - 1] = f[i + 1] - 2.0 * f[i] + f[i - 1];
+    return robustSigma(std::move(d)) / std::sqrt(6.0);
 }
 
 std::vector<double> restDifferences(std::vector<double> rest, double fs)
@@ -47,9 +46,7 @@ std::vector<double> restDifferences(std::vector<double> rest, double fs)
 
 double slipFloorOf(std::vector<double> differences)
 {
-    if (differences.empty()) return 0.0;
-    for (double& x : differences) x = std::abs(x);
-    return 6.0 * 1.4826 * median(std::move(differences)) / std::sqrt(3.0);
+    return 6.0 * robustSigma(std::move(differences)) / std::sqrt(3.0);
 }
 
 StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s, std::optional<double> slipFloor)

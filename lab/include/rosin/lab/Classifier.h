@@ -19,6 +19,17 @@ bool isSuccess(Regime r); ///< Helmholtz or S-motion within the cap
 /// Samples in the 0.1 ms a first slip must drop the force within (at least 2).
 inline int slipDropWindow(double sampleRate) { return std::max(2, static_cast<int>(std::lround(1e-4 * sampleRate))); }
 
+/// Standard deviation of zero-mean Gaussian values from the median of their magnitudes
+/// (1.4826 x median |x|): flybacks and slips, a minority, leave it alone.
+inline double robustSigma(std::vector<double> x)
+{
+    if (x.empty()) return 0.0;
+    for (double& v : x) v = std::abs(v);
+    const auto mid = x.begin() + static_cast<long>(x.size() / 2);
+    std::nth_element(x.begin(), mid, x.end());
+    return 1.4826 * *mid;
+}
+
 struct ClassifierSettings {
     double flybackFraction = 0.35;  ///< gamma: a flyback drops more than gamma * 2 Z0 vb / beta
     int capPeriods = 25;            ///< transients longer than this are failures [WG25; GW14]
