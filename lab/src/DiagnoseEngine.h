@@ -251,10 +251,9 @@ private:
         std::unique_ptr<dsp::BowedString<double>> string;
         double gain = 1.0; ///< recordedGain() of the model, taken when the voice is prepared
     };
-    /// What model m (voice config c) has its simulated bridge force multiplied by before it meets
-    /// the recordings: 1, except for a rolling string without thermal memory when the scale came
-    /// from the ramps (1 / rollingSoftening()).
-    double recordedGain(const EffectModel& m, const dsp::BowedStringConfig& c) const;
+    /// What a model (voice config c) has its simulated bridge force multiplied by before it meets
+    /// the recordings: 1, or 1 / rollingSoftening() when the scale came from the ramps.
+    double recordedGain(const dsp::BowedStringConfig& c) const;
     std::vector<Prepared>& strokes_;
     StringInfo info_;
     double fs_;

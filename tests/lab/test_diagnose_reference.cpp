@@ -269,6 +269,17 @@ TEST(DiagnoseReference, FindsAStronglyRollingStringAndTakesItsSofteningOutOfTheS
 // named; a -14 K rosin shift comes out near -20 K), so they run with the `long` label, not in CI.
 TEST(DiagnoseReferenceLong, FindsTorsion) { expectDiagnosis(run({"torsional_compliance"}, {{"zt_ratio", 1.6}}, 44)); }
 
+// The same quiet rig as the strongly rolling string above, with thermal memory beside the roll
+// (Z_t/Z_0 = 1.3). Not met yet: the model at the rig's own values fits the fit strokes 0.074
+// against 0.105 for thermal memory alone, but only in a narrow valley of r_A, the bow side's
+// effusivity and the tension (4 % off in either nuisance loses most of the gain), which the
+// candidate's grid and COBYLA do not find: torsion comes out at Z_t/Z_0 7.8 and r_A 13 % high.
+TEST(DiagnoseReferenceLong, FindsARollingStringBesideThermalMemory)
+{
+    expectDiagnosis(run({"thermal_memory", "torsional_compliance"}, {{"zt_ratio", 1.3}, {"r_A", 1.0}}, 7102, 12, "guettler", "V",
+                        {{"inharmonicity", 1e-8}, {"bridge_z0y", 1e-4}, {"body_z0y", 1e-4}, {"sensor_hz", 30000.0}, {"sensor_q", 0.7}, {"headroom", 0.8}}));
+}
+
 TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temperature_shift"}, {{"r_A", 1.2}, {"shift_k", -14.0}}, 45)); }
 
 // Effects and rigs drawn truly at random from a seed printed here: run by hand or in `long`.
