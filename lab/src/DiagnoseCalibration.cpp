@@ -270,8 +270,7 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
         if (set.strokes[i].trigger) cal[i].trigger = *set.strokes[i].trigger;
     });
     std::vector<Prepared> strokes(n);
-    std::vector<std::vector<double>> rests(n);      // restDifferences() of each stroke
-    std::vector<std::vector<double>> restNoise(n);  // each rest away from its ends (N at the diagnosis rate)
+    std::vector<std::vector<double>> rests(n); // restDifferences() of each stroke
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
         const MeasuredStroke& s = set.strokes[i];
         Prepared& p = strokes[i];
@@ -283,10 +282,7 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
         const double toNewtons = cal[i].rampFitted ? cal[i].gain / gain : 1.0 / gain;
         for (std::size_t k = 0; k < from; ++k) rest.push_back(cal[i].force[k] * toNewtons);
         for (std::size_t k = from; k < cal[i].force.size(); ++k) f.push_back(cal[i].force[k] * toNewtons);
-        rest = resample(rest, set.sampleRate, o.simRate);
-        const auto edge = static_cast<std::size_t>(std::lround(1e-3 * o.simRate)); // filters settling, a trigger read early
-        if (rest.size() > 3 * edge) restNoise[i].assign(rest.begin() + static_cast<long>(edge), rest.end() - static_cast<long>(edge));
-        rests[i] = restDifferences(std::move(rest), o.simRate);
+        rests[i] = restDifferences(resample(rest, set.sampleRate, o.simRate), o.simRate);
         f = resample(f, set.sampleRate, o.simRate);
         f.resize(std::min(f.size(), static_cast<std::size_t>(0.5 * o.simRate)));
         p.force = std::move(f);
@@ -314,33 +310,7 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
         d.warnings.push_back("less than 10 ms of rest before the gestures in the whole set: the first-slip detector reads each "
                              "stroke's noise from the stroke itself, which misses most of a low-passed noise");
     }
-    // The noise the simulations get: the rests' level and colour (an AR(12) shape), the same for
-    // every stroke; without 10 ms of rest, white noise at each stroke's own level.
-    std::shared_ptr<const NoiseShape> noiseShape;
-    if (slipFloor) {
-        auto shape = std::make_shared<NoiseShape>(fitNoiseShape(restNoise, 12));
-        if (shape->rms > 0.0) {
-            std::vector<double> single;
-            for (const auto& r : restNoise)
-                if (r.size() >= static_cast<std::size_t>(1e-3 * o.simRate)) {
-                    double m = 0, v = 0;
-                    for (double x : r) m += x / static_cast<double>(r.size());
-                    for (double x : r) v += (x - m) * (x - m) / static_cast<double>(r.size());
-                    single.push_back(std::sqrt(v));
-                }
-            std::sort(single.begin(), single.end());
-            const bool spread = single.size() >= 5;
-            d.calibration.push_back({"noise_rms_n",
-                                     "the rig's noise as the calibrated recordings carry it, from the rests before the gestures (pooled); "
-                                     "simulations get noise of this level and colour (an autoregressive shape of order 12); the interval "
-                                     "is the range single strokes' rests give",
-                                     shape->rms, spread ? single[single.size() / 40] : shape->rms,
-                                     spread ? single[single.size() - 1 - single.size() / 40] : shape->rms});
-            noiseShape = std::move(shape);
-        }
-    }
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-        strokes[i].noiseShape = noiseShape;
         strokes[i].slipFloor = slipFloor;
         strokes[i].feat = features(strokes[i].force, o.simRate, strokes[i].gesture, info, slipFloor);
     });

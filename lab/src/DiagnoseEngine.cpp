@@ -1,6 +1,5 @@
 #include "DiagnoseEngine.h"
 
-#include <Eigen/Dense>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -146,60 +145,14 @@ double Engine::beta(const EffectModel& m) const
     return info_.beta * (m.params.count("beta_scale") ? m.params.at("beta_scale") : 1.0);
 }
 
-NoiseShape fitNoiseShape(const std::vector<std::vector<double>>& rests, int order)
-{
-    // Biased autocorrelation pooled over the segments: its Toeplitz matrix is positive
-    // definite, so the Yule-Walker filter is stable.
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(order + 1);
-    double count = 0;
-    for (const auto& seg : rests) {
-        if (seg.size() <= static_cast<std::size_t>(order)) continue;
-        double m = 0;
-        for (double x : seg) m += x;
-        m /= static_cast<double>(seg.size());
-        for (int k = 0; k <= order; ++k)
-            for (std::size_t n = 0; n + static_cast<std::size_t>(k) < seg.size(); ++n) r[k] += (seg[n] - m) * (seg[n + static_cast<std::size_t>(k)] - m);
-        count += static_cast<double>(seg.size());
-    }
-    NoiseShape shape;
-    if (count < 4.0 * order || !(r[0] > 0.0)) return shape;
-    r /= count;
-    shape.rms = std::sqrt(r[0]);
-    Eigen::MatrixXd R(order, order);
-    for (int i = 0; i < order; ++i)
-        for (int j = 0; j < order; ++j) R(i, j) = r[std::abs(i - j)];
-    const Eigen::VectorXd a = R.ldlt().solve(r.segment(1, order));
-    const double e2 = r[0] - a.dot(r.segment(1, order));
-    if (!a.allFinite() || !(e2 > 0.0)) {
-        shape.innovation = shape.rms; // white at the measured level
-        return shape;
-    }
-    shape.ar.assign(a.data(), a.data() + order);
-    shape.innovation = std::sqrt(e2);
-    return shape;
-}
-
-std::vector<double> shapedNoise(const NoiseShape& shape, std::size_t length, std::uint64_t seed)
-{
-    if (!(shape.innovation > 0.0)) return std::vector<double>(length, 0.0);
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> g(0.0, shape.innovation);
-    const std::size_t p = shape.ar.size(), settle = 64 * p; // the filter forgets its zero start
-    std::vector<double> x(settle + length, 0.0);
-    for (std::size_t n = 0; n < x.size(); ++n) {
-        double v = g(rng);
-        for (std::size_t k = 0; k < p && k < n; ++k) v += shape.ar[k] * x[n - 1 - k];
-        x[n] = v;
-    }
-    return {x.begin() + static_cast<long>(settle), x.end()};
-}
-
 namespace {
-std::vector<double> strokeNoise(const Prepared& p, std::size_t stroke, std::size_t length, std::uint64_t seed)
+std::vector<double> strokeNoise(std::size_t stroke, std::size_t length, double level, std::uint64_t seed)
 {
-    const std::uint64_t s = 0x9e3779b97f4a7c15ull * (stroke + 1) + seed;
-    if (p.noiseShape) return shapedNoise(*p.noiseShape, length, s);
-    return shapedNoise(NoiseShape{{}, p.noise, p.noise}, length, s);
+    std::vector<double> x(length);
+    std::mt19937_64 rng(0x9e3779b97f4a7c15ull * (stroke + 1) + seed);
+    std::normal_distribution<double> g(0.0, level);
+    for (double& v : x) v = g(rng);
+    return x;
 }
 } // namespace
 
@@ -224,7 +177,7 @@ Engine::Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs
     : strokes_(strokes), info_(info), fs_(fs), steady_(steady), scaleFromRamps_(scaleFromRamps), noise_(strokes.size())
 {
     tbb::parallel_for(std::size_t(0), strokes.size(), [&](std::size_t i) {
-        noise_[i] = strokeNoise(strokes[i], i, strokes[i].force.size(), 0);
+        if (strokes[i].noise > 0.0) noise_[i] = strokeNoise(i, strokes[i].force.size(), strokes[i].noise, 0);
     });
 }
 
@@ -253,10 +206,10 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
     }
     ++simulations_;
     if (head) head->assign(out.begin(), out.begin() + static_cast<long>(std::min(out.size(), static_cast<std::size_t>(12.0 * fs_ / info_.f0 + 0.02 * fs_))));
-    {
-        const std::vector<double> other = noiseSeed == 0 ? std::vector<double>{} : strokeNoise(p, i, out.size(), noiseSeed);
+    if (p.noise > 0.0) {
+        const std::vector<double> other = noiseSeed == 0 ? std::vector<double>{} : strokeNoise(i, out.size(), p.noise, noiseSeed);
         const std::vector<double>& add = noiseSeed == 0 ? noise_[i] : other;
-        for (std::size_t n = 0; n < out.size() && n < add.size(); ++n) out[n] += add[n];
+        for (std::size_t n = 0; n < out.size(); ++n) out[n] += add[n];
     }
     return features(std::move(out), fs_, p.gesture, info_, p.slipFloor);
 }

@@ -25,31 +25,11 @@ struct StringInfo {
     double f0, beta, z0, tension, length;
 };
 
-/// The rig's noise as a calibrated recording carries it (after the sensor, the amplifier and
-/// the calibration's low-pass): an autoregressive process x[n] = sum_k ar[k] x[n-1-k] + e[n],
-/// fitted to the rests before the gestures, so a simulation gets noise of the recordings' level
-/// *and* colour. A level read from the stroke's own lag-1 differences misses most of a low-passed
-/// noise (a fifth of a 10 kHz-low-passed white noise at 48 kHz).
-struct NoiseShape {
-    std::vector<double> ar;
-    double innovation = 0; ///< rms of e (N)
-    double rms = 0;        ///< rms of x (N)
-};
-
-/// Yule-Walker fit (Eigen) of an AR(order) shape to rest segments (N at one rate; each segment's
-/// mean taken out). Empty (ar and rms 0) when the segments hold fewer than 4 x order samples.
-NoiseShape fitNoiseShape(const std::vector<std::vector<double>>& rests, int order);
-/// length samples of noise of that shape; the same seed gives the same noise.
-std::vector<double> shapedNoise(const NoiseShape& shape, std::size_t length, std::uint64_t seed);
-
 struct Prepared {
     std::string id;
     Gesture gesture;           ///< as the manifest states it (t = 0 at the gesture start)
     std::vector<double> force; ///< N at the diagnosis rate, t = 0 at the gesture start
-    /// Noise added to the recording's simulations: the set's shape read from its rests, or, when
-    /// the set has too little rest, white noise of the stroke's own level (noise, N rms).
-    std::shared_ptr<const NoiseShape> noiseShape;
-    double noise = 0;
+    double noise = 0;          ///< rms noise of the recording (N), added to its simulations
     /// The least drop within 0.1 ms that is a first slip and not the rig's noise (N), for the
     /// recording and its simulations alike; unset: each signal's own estimate (noiseLevel).
     std::optional<double> slipFloor;

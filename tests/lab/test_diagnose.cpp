@@ -334,63 +334,6 @@ TEST(DiagnoseNoise, NoiseAloneFiresNoFirstSlipAtLowForce)
     EXPECT_GE(earlyBefore, 2) << "the stroke's own noise estimate, which this floor replaced, fired early here";
 }
 
-TEST(DiagnoseNoise, AnAutoregressiveShapeIsRecoveredFromShortRests)
-{
-    // x[n] = 1.2 x[n-1] - 0.5 x[n-2] + e[n], e of 0.01 N rms, in 80 rests of 10 ms at 48 kHz (a
-    // set's rests are a few to 20 ms each): the coefficients, the innovation and the level.
-    std::mt19937_64 rng(7);
-    std::normal_distribution<double> g(0.0, 0.01);
-    std::vector<std::vector<double>> rests;
-    double sum2 = 0, count = 0;
-    for (int k = 0; k < 80; ++k) {
-        std::vector<double> x(480 + 200, 0.0);
-        for (std::size_t n = 2; n < x.size(); ++n) x[n] = 1.2 * x[n - 1] - 0.5 * x[n - 2] + g(rng);
-        rests.emplace_back(x.begin() + 200, x.end());
-        for (double v : rests.back()) sum2 += v * v, ++count;
-    }
-    const diag::NoiseShape shape = diag::fitNoiseShape(rests, 2);
-    ASSERT_EQ(shape.ar.size(), 2u);
-    EXPECT_NEAR(shape.ar[0], 1.2, 0.03);
-    EXPECT_NEAR(shape.ar[1], -0.5, 0.03);
-    EXPECT_NEAR(shape.innovation, 0.01, 0.0003);
-    EXPECT_NEAR(shape.rms, std::sqrt(sum2 / count), 0.02 * std::sqrt(sum2 / count));
-    // Too little to read: no shape.
-    EXPECT_EQ(diag::fitNoiseShape({std::vector<double>(5, 1.0)}, 2).rms, 0.0);
-}
-
-TEST(DiagnoseNoise, SimulationsGetTheRestsLevelAndColour)
-{
-    // A rig's white noise (0.01 N rms at 48 kHz) after the calibration's 10 kHz low-pass, in 60
-    // rests of 10 ms. Noise made from the shape fitted to them must look like it to the
-    // comparison: within 5 % in rms after the 5 kHz low-pass, and within 10 % in the first-slip
-    // detector's floor. White noise at the stroke's own lag-1 level (what simulations got
-    // before) is less than half as strong there.
-    const double fs = 48000.0;
-    std::mt19937_64 rng(11);
-    std::normal_distribution<double> g(0.0, 0.01);
-    std::vector<double> rig(static_cast<std::size_t>(0.9 * fs));
-    for (double& x : rig) x = g(rng);
-    zeroPhaseLowPass(rig, 10000.0, fs);
-    std::vector<std::vector<double>> rests;
-    for (std::size_t k = 0; k + 480 <= rig.size(); k += 720) rests.emplace_back(rig.begin() + static_cast<long>(k), rig.begin() + static_cast<long>(k + 480));
-    const diag::NoiseShape shape = diag::fitNoiseShape(rests, 12);
-    std::vector<double> made = diag::shapedNoise(shape, rig.size(), 5);
-    ASSERT_EQ(made.size(), rig.size());
-    EXPECT_EQ(made, diag::shapedNoise(shape, rig.size(), 5)) << "one seed, one noise";
-    auto inBand = [&](std::vector<double> x) {
-        zeroPhaseLowPass(x, diag::kCompareCutoff, fs);
-        double s = 0;
-        for (std::size_t i = 1000; i + 1000 < x.size(); ++i) s += x[i] * x[i];
-        return std::sqrt(s / static_cast<double>(x.size() - 2000));
-    };
-    const double want = inBand(rig);
-    EXPECT_NEAR(inBand(made), want, 0.05 * want);
-    const double floor = diag::slipFloorOf(diag::restDifferences(rig, fs));
-    EXPECT_NEAR(diag::slipFloorOf(diag::restDifferences(made, fs)), floor, 0.1 * floor);
-    const diag::NoiseShape white{{}, diag::noiseLevel(rig), diag::noiseLevel(rig)};
-    EXPECT_LT(inBand(diag::shapedNoise(white, rig.size(), 5)), 0.5 * want);
-}
-
 TEST(DiagnoseSystematic, ARepeatedStrokeIsSimulatedOnceAndScoredAsOftenAsItAppears)
 {
     diag::StringInfo info;
