@@ -133,17 +133,17 @@ std::vector<Candidate> candidates(const EffectModel& m)
     if (!thermal) out.push_back(candidate("thermal_memory", {"r_A"}, {1.0}));
     if (!has(m.effects, "rate_dependence")) out.push_back(withThermal(candidate("rate_dependence", {"h0", "p"}, {0.563, 0.4})));
     // Once thermal memory is named, r_A has taken up part of a contact's footprint: the contact's
-    // grid spans r_A too, or the search starts where r_A stands in for it and stays there.
-    if (!has(m.effects, "hertzian_contact"))
-        out.push_back(thermal && m.params.count("r_A") ? candidate("hertzian_contact", {"load_exponent", "r_A"}, {0.8, m.params.at("r_A")})
-                                                       : candidate("hertzian_contact", {"load_exponent"}, {0.8}));
-    if (!has(m.effects, "rosin_temperature_shift")) out.push_back(withThermal(candidate("rosin_temperature_shift", {"shift_k"}, {0.0})));
-    // So does a rolling string's: its forces are 1/s too large in the ramps' scale, which a higher
+    // grid spans r_A too, or the search starts where r_A stands in for it and stays there. It takes
+    // up a rolling string's too: its forces are 1/s too large in the ramps' scale, which a higher
     // r_A gives too (seed 2042, set 0: r_A 1.25 named for 1.03 beside an unnamed Z_t/Z_0 1.25,
     // and torsion added at that r_A fitted far worse than none).
-    if (!has(m.effects, "torsional_compliance"))
-        out.push_back(thermal && m.params.count("r_A") ? candidate("torsional_compliance", {"zt_ratio", "r_A"}, {2.0, m.params.at("r_A")})
-                                                       : candidate("torsional_compliance", {"zt_ratio"}, {2.0}));
+    auto spanningRA = [&](const std::string& effect, const std::string& parameter, double start) {
+        return thermal && m.params.count("r_A") ? candidate(effect, {parameter, "r_A"}, {start, m.params.at("r_A")})
+                                                : candidate(effect, {parameter}, {start});
+    };
+    if (!has(m.effects, "hertzian_contact")) out.push_back(spanningRA("hertzian_contact", "load_exponent", 0.8));
+    if (!has(m.effects, "rosin_temperature_shift")) out.push_back(withThermal(candidate("rosin_temperature_shift", {"shift_k"}, {0.0})));
+    if (!has(m.effects, "torsional_compliance")) out.push_back(spanningRA("torsional_compliance", "zt_ratio", 2.0));
     return out;
 }
 

@@ -167,7 +167,7 @@ double Engine::recordedGain(const dsp::BowedStringConfig& c) const
     // The ramps' scale made a rolling string's forces 1 / softening too large, so a rolling model
     // is compared in that scale, where it slips later at a higher force. Thermal models were once
     // exempt (torsion had stood in for a -17 K shift on a model-made set), which left a thermal
-    // model with torsion at its true Z_t/Z_0 a fifth short in every force and torsion beside
+    // model with torsion at its true Z_t/Z_0 about 13 % short in every force and torsion beside
     // thermal memory unnamed (docs/diagnosis.md, step 2).
     return scaleFromRamps_ ? 1.0 / rollingSoftening(c) : 1.0;
 }

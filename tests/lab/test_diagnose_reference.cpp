@@ -248,6 +248,9 @@ TEST(DiagnoseReference, RefusesAVoltSetOfOnlyRisingForceStrokes)
     }
 }
 
+/// A rig close to the waveguide: little stiffness, a stiff bridge and body, a fast sensor.
+const std::map<std::string, double> kQuietRig{{"inharmonicity", 1e-8}, {"bridge_z0y", 1e-4}, {"body_z0y", 1e-4}, {"sensor_hz", 30000.0}, {"sensor_q", 0.7}, {"headroom", 0.8}};
+
 // A string that rolls readily (Z_t/Z_0 = 1.5), on a rig whose string, bridge and sensor come close
 // to the waveguide's (little stiffness, a stiff bridge, a fast sensor), in volts: the ramps' scale
 // reads the rolling string as a stiffer one and inflates every force by about 15 % (this rig's
@@ -257,7 +260,7 @@ TEST(DiagnoseReference, RefusesAVoltSetOfOnlyRisingForceStrokes)
 TEST(DiagnoseReference, FindsAStronglyRollingStringAndTakesItsSofteningOutOfTheScale)
 {
     const Outcome o = run({"torsional_compliance"}, {{"zt_ratio", 1.5}}, 7101, 12, "guettler", "V",
-                          {{"inharmonicity", 1e-8}, {"bridge_z0y", 1e-4}, {"body_z0y", 1e-4}, {"sensor_hz", 30000.0}, {"sensor_q", 0.7}, {"headroom", 0.8}});
+                          kQuietRig);
     expectDiagnosis(o);
     double scale = 0;
     for (const auto& c : o.d.calibration)
@@ -279,7 +282,7 @@ TEST(DiagnoseReferenceLong, FindsTorsion) { expectDiagnosis(run({"torsional_comp
 TEST(DiagnoseReferenceLong, FindsARollingStringBesideThermalMemory)
 {
     expectDiagnosis(run({"thermal_memory", "torsional_compliance"}, {{"zt_ratio", 1.3}, {"r_A", 1.0}}, 7102, 12, "guettler", "V",
-                        {{"inharmonicity", 1e-8}, {"bridge_z0y", 1e-4}, {"body_z0y", 1e-4}, {"sensor_hz", 30000.0}, {"sensor_q", 0.7}, {"headroom", 0.8}}));
+                        kQuietRig));
 }
 
 TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temperature_shift"}, {{"r_A", 1.2}, {"shift_k", -14.0}}, 45)); }
