@@ -188,6 +188,19 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             say("round " + std::to_string(round) + ": " + cands[k].effect, static_cast<double>(k) / static_cast<double>(cands.size()));
             double fitError = 0;
             Tried t{cands[k], diag::fit(engine, current, cands[k], fitSet, cands[k].start, o.maxEvaluations, 0.2, &fitError), {}, {}, d.trials.size()};
+            // A rolling string changes the scale of every force the ramps read, so the parameters
+            // named without it sit far from where they belong beside it, and the grid from there
+            // misses the valley: search also from where round 1 left the torsion on the baseline,
+            // with twice the evaluations (COBYLA spends one per parameter, seven or more here,
+            // before its first step).
+            if (const auto from = roundOneStart(d.trials, cands[k]); round > 1 && from) {
+                double warmError = 0.0;
+                std::vector<double> warm = diag::fit(engine, current, cands[k], fitSet, *from, 2 * o.maxEvaluations, 0.2, &warmError, false);
+                if (warmError < fitError) {
+                    t.x = std::move(warm);
+                    fitError = warmError;
+                }
+            }
             t.val = engine.errors(apply(current, t.c, t.x), valSet);
             t.gain = pairedGain(currentVal, t.val, o.bootstrap, o.seed + static_cast<std::uint64_t>(round * 100 + static_cast<int>(k)));
             Trial trial;

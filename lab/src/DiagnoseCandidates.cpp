@@ -289,6 +289,23 @@ bool movedToNull(const Finding& f, const std::map<std::string, double>& now)
     return false;
 }
 
+std::optional<std::vector<double>> roundOneStart(const std::vector<Trial>& trials, const Candidate& c)
+{
+    if (c.effect != "torsional_compliance") return std::nullopt;
+    for (const Trial& t : trials) {
+        if (t.round != 1 || t.effect != c.effect || atNull(c.effect, t.parameters)) continue;
+        std::vector<double> start = c.start;
+        bool moved = false;
+        for (std::size_t k = 0; k < c.scanned; ++k)
+            if (c.names[k] == "zt_ratio" && t.parameters.count(c.names[k])) {
+                start[k] = t.parameters.at(c.names[k]);
+                moved = true;
+            }
+        if (moved) return start;
+    }
+    return std::nullopt;
+}
+
 bool shiftFlippedBesideRateLaw(const std::vector<Trial>& trials, double shiftNow, double least)
 {
     for (const Trial& t : trials)

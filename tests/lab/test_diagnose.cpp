@@ -216,6 +216,41 @@ TEST(DiagnoseParameters, AShiftThatFlipsSignBesideARateLawIsAStandIn)
     EXPECT_FALSE(diag::shiftFlippedBesideRateLaw({trial(2, "rosin_temperature_shift", 24.0)}, -20.0)); // no round-1 candidate
 }
 
+// A later round's torsion candidate is searched also from round 1's Z_t/Z_0 (the rest of the start
+// as the model has it), and only when round 1 fitted some torsion on the baseline.
+TEST(DiagnoseParameters, ALaterTorsionSearchAlsoStartsWhereRoundOneLeftItsZt)
+{
+    auto trial = [](int round, const std::string& effect, std::map<std::string, double> p) {
+        Trial t;
+        t.round = round;
+        t.effect = effect;
+        t.parameters = std::move(p);
+        return t;
+    };
+    EffectModel named;
+    named.effects = {"thermal_memory", "rate_dependence"};
+    named.params = {{"r_A", 1.25}, {"h0", 0.75}, {"p", 0.68}, {"tension_scale", 0.98}, {"beta_scale", 1.02}, {"rod_effusivity_scale", 1.0}};
+    const auto cands = diag::candidates(named);
+    const auto torsion = std::find_if(cands.begin(), cands.end(), [](const diag::Candidate& c) { return c.effect == "torsional_compliance"; });
+    ASSERT_NE(torsion, cands.end());
+    const diag::Candidate c = diag::withNuisances(*torsion, named);
+    ASSERT_EQ(c.names.front(), "zt_ratio");
+
+    const std::vector<Trial> rolled{trial(1, "thermal_memory", {{"r_A", 1.35}}), trial(1, "torsional_compliance", {{"zt_ratio", 1.06}, {"tension_scale", 0.97}}),
+                                    trial(2, "torsional_compliance", {{"zt_ratio", 7.9}})};
+    const auto start = diag::roundOneStart(rolled, c);
+    ASSERT_TRUE(start.has_value());
+    ASSERT_EQ(start->size(), c.start.size());
+    EXPECT_DOUBLE_EQ(start->front(), 1.06);
+    for (std::size_t k = 1; k < c.start.size(); ++k) EXPECT_DOUBLE_EQ((*start)[k], c.start[k]) << c.names[k]; // r_A, p, nuisances as named
+
+    EXPECT_FALSE(diag::roundOneStart({trial(1, "torsional_compliance", {{"zt_ratio", 7.6}})}, c).has_value()); // round 1 saw no torsion
+    EXPECT_FALSE(diag::roundOneStart({trial(2, "torsional_compliance", {{"zt_ratio", 1.2}})}, c).has_value()); // not round 1's
+    const auto contact = std::find_if(cands.begin(), cands.end(), [](const diag::Candidate& x) { return x.effect == "hertzian_contact"; });
+    ASSERT_NE(contact, cands.end());
+    EXPECT_FALSE(diag::roundOneStart({trial(1, "hertzian_contact", {{"load_exponent", 0.7}})}, diag::withNuisances(*contact, named)).has_value());
+}
+
 // Rule 2's comparisons with the round's other candidates, in their order, with the shares written
 // into the trial.
 TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneAndWithEachOther)
