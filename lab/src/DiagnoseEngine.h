@@ -168,12 +168,12 @@ double relativeFall(double before, double after);
 /// flip round 1's sign. Returns the failed rule's verdict, or "" when the candidate passes.
 std::string standInVerdict(Trial& trial, const Candidate& c, const std::map<std::string, double>& roundValidation,
                            const std::vector<std::string>& namedEffects, const std::vector<Trial>& trials, double threshold);
-/// A rosin shift fitted beside a named rate law, `shiftNow`, against round 1's shift candidate
-/// (fitted before any rate law): true when round 1 asked for at least `least` kelvin of one sign
-/// and the shift now has the other. Round 1's `trials` give that candidate; none, no flip.
 /// A second start for a later round's torsion candidate: its own parameter where round 1 left it
 /// on the baseline (the rest where the model has them), unless round 1 fitted no torsion there.
 std::optional<std::vector<double>> roundOneStart(const std::vector<Trial>& trials, const Candidate& c);
+/// A rosin shift fitted beside a named rate law, `shiftNow`, against round 1's shift candidate
+/// (fitted before any rate law): true when round 1 asked for at least `least` kelvin of one sign
+/// and the shift now has the other. Round 1's `trials` give that candidate; none, no flip.
 bool shiftFlippedBesideRateLaw(const std::vector<Trial>& trials, double shiftNow, double least = 10.0);
 /// The strokes of `from` in the upper (or lower) half of their gesture's drive (bow acceleration
 /// for Guettler strokes); the median is taken per gesture kind, so a mixed set splits evenly.
