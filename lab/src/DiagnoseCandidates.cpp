@@ -291,17 +291,14 @@ bool movedToNull(const Finding& f, const std::map<std::string, double>& now)
 
 std::optional<std::vector<double>> roundOneStart(const std::vector<Trial>& trials, const Candidate& c)
 {
-    if (c.effect != "torsional_compliance") return std::nullopt;
+    const auto own = std::find(c.names.begin(), c.names.end(), "zt_ratio");
+    if (c.effect != "torsional_compliance" || own == c.names.end()) return std::nullopt;
     for (const Trial& t : trials) {
-        if (t.round != 1 || t.effect != c.effect || atNull(c.effect, t.parameters)) continue;
+        const auto zt = t.parameters.find("zt_ratio");
+        if (t.round != 1 || t.effect != c.effect || zt == t.parameters.end() || atNull(c.effect, t.parameters)) continue;
         std::vector<double> start = c.start;
-        bool moved = false;
-        for (std::size_t k = 0; k < c.scanned; ++k)
-            if (c.names[k] == "zt_ratio" && t.parameters.count(c.names[k])) {
-                start[k] = t.parameters.at(c.names[k]);
-                moved = true;
-            }
-        if (moved) return start;
+        start[static_cast<std::size_t>(own - c.names.begin())] = zt->second;
+        return start;
     }
     return std::nullopt;
 }
