@@ -82,6 +82,46 @@ TEST(OnePoleLoss, HitsBothMagnitudeTargetsAndReportsItsPhaseDelay)
     EXPECT_NEAR(lastCrossOut - lastCrossIn, pd, 0.01);
 }
 
+// The DC shelf gives back at zero frequency what the low-pass loses there (a held deflection
+// holds), while the pair still hits both targets and its phase delay is what a sine measures.
+TEST(OnePoleLoss, TheDcShelfRestoresUnitGainAtDcAndKeepsBothTargets)
+{
+    // Targets of the cello D's torsional finger side at 48 kHz: the heaviest loss the string has.
+    const double w1 = 2 * std::numbers::pi * 146.83 / 48000, w2 = 5 * w1, m1 = 0.909105, m2 = 0.620969;
+    OnePoleLoss<double> plain, restored;
+    plain.design(m1, w1, m2, w2);
+    restored.design(m1, w1, m2, w2, 0.5 * w1);
+    EXPECT_NEAR(plain.dcGain(), 0.9316, 0.002); // the low-pass alone loses 7 % at DC
+    EXPECT_NEAR(restored.dcGain(), 1.0, 2e-6);
+    EXPECT_LE(restored.dcGain(), OnePoleLoss<double>::kDcGain);
+    EXPECT_NEAR(restored.magnitude(w1), m1, 5e-4);
+    EXPECT_NEAR(restored.magnitude(w2), m2, 5e-4);
+    for (double w = 0.001; w < 3.1; w *= 1.3) EXPECT_LE(restored.magnitude(w), 1.0) << "w=" << w; // passive
+    // DC: a step settles at the DC gain.
+    OnePoleLoss<double> g = restored;
+    g.reset();
+    double y = 0;
+    for (int n = 0; n < 200000; ++n) y = g.process(1.0);
+    EXPECT_NEAR(y, 1.0, 2e-6);
+    // Phase delay against a slow sine's zero crossings.
+    double lastCrossIn = 0, lastCrossOut = 0, prevIn = 0, prevOut = 0;
+    g.reset();
+    for (int n = 0; n < 40000; ++n) {
+        const double x = std::sin(w1 * n);
+        y = g.process(x);
+        if (prevIn < 0 && x >= 0) lastCrossIn = n - x / (x - prevIn);
+        if (prevOut < 0 && y >= 0) lastCrossOut = n - y / (y - prevOut);
+        prevIn = x;
+        prevOut = y;
+    }
+    EXPECT_NEAR(lastCrossOut - lastCrossIn, restored.phaseDelay(w1), 0.01);
+    // Rounded to float, the DC gain still never exceeds 1.
+    OnePoleLoss<float> single;
+    single.design(m1, w1, m2, w2, 0.5 * w1);
+    EXPECT_LE(single.dcGain(), OnePoleLoss<float>::kDcGain);
+    EXPECT_NEAR(single.dcGain(), 1.0, 1e-5);
+}
+
 TEST(DispersionChain, PhaseDelayFallsWithFrequency)
 {
     const double a = -0.5;

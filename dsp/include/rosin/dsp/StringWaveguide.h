@@ -35,6 +35,14 @@ struct WaveguideOptions {
     /// Lowest fundamental the delay lines must hold, as a fraction of the open string's: a
     /// playable voice bends below the open pitch; research runs keep 1.
     double lowestPitchRatio = 1.0;
+    /// Corner of the low shelf that gives each lossy reflection back its DC, as a fraction of
+    /// f0, so that a held deflection holds (ReflectionFilter.h; 0.5 is the measured choice).
+    /// 0 = off, the reflections lose at DC about what they lose at f0 and a sticking bow's ramp
+    /// creeps soft. Off by default until the instrument's tuning and the diagnosis are
+    /// calibrated with it (docs/model.md): with it on, the violin's open E sounds 5.9 cents flat,
+    /// a stopped martele bow holds the string bent, and two strings need over 20 periods to
+    /// reach Helmholtz at the default velocity.
+    double dcRestoreCorner = 0.0;
 };
 
 template <typename T>
@@ -70,6 +78,7 @@ public:
     {
         lines_.reset();
         lossState_ = Pack4{};
+        topState_ = Pack4{};
         dispersion_.reset();
         u1In_ = u2In_ = u1tIn_ = u2tIn_ = T(0);
         bridgeForce_ = T(0);
@@ -145,6 +154,9 @@ public:
         for (int k = 0; k < 4; ++k) {
             lossB0_[k] = loss[k]->b0;
             lossA1_[k] = loss[k]->a1;
+            top0_[k] = loss[k]->top0;
+            top1_[k] = loss[k]->top1;
+            shelfPole_[k] = loss[k]->shelfPole;
         }
         weightsBridgeOut_ = stencilWeights(tapBridgeOut_);
         weightsFinger_ = stencilWeights(tapFinger_);
@@ -272,8 +284,11 @@ public:
                                              loadStencil(origin, tapFinger_) * weightsFinger_,
                                              loadStencil(origin, tapTorsionBridge_) * weightsTorsionBridge_,
                                              loadStencil(origin, tapTorsionFinger_) * weightsTorsionFinger_);
-        const Pack4 filtered = lossB0_ * reads - lossA1_ * lossState_;
-        lossState_ = filtered;
+        const Pack4 lowPassed = lossB0_ * reads - lossA1_ * lossState_;
+        const Pack4 top = top0_ * lowPassed + top1_ * lossState_ + shelfPole_ * topState_;
+        const Pack4 filtered = lowPassed + top;
+        lossState_ = lowPassed;
+        topState_ = top;
         const T arriving = reads[kBridge];
         bridgeForce_ = static_cast<T>(z0_) * (arriving + filtered[kBridge]);
         u1In_ = lines_.read(tapBridgeBack_);
@@ -300,12 +315,14 @@ private:
     };
     using Tap = typename DelayLines<T>::Tap;
 
-    /// One-pole loss of one reflection (its lane of the packed filter state).
+    /// Loss of one reflection, low-pass then DC shelf (its lane of the packed filter state).
     T loss(int lane, T x) noexcept
     {
         const T y = lossB0_[lane] * x - lossA1_[lane] * lossState_[lane];
+        const T top = top0_[lane] * y + top1_[lane] * lossState_[lane] + shelfPole_[lane] * topState_[lane];
         lossState_[lane] = y;
-        return y;
+        topState_[lane] = top;
+        return y + top;
     }
 
     static Pack4 stencilWeights(const Tap& t) noexcept { return Pack4{t.h3, t.h2, t.h1, t.h0}; }
@@ -349,7 +366,8 @@ private:
                                         : lossFactor(f0_, f0_, params_.qLow, params_.qHigh, params_.qHighFrequency);
         const double etaHigh = torsional ? 1.0 / params_.qTorsion
                                          : lossFactor(fLossProbe_, f0_, params_.qLow, params_.qHigh, params_.qHighFrequency);
-        filter.design(segmentMagnitude(f0_, tau, etaLow), w0_, segmentMagnitude(fLossProbe_, tau, etaHigh), wLossProbe_);
+        const double wRestore = 2.0 * std::numbers::pi * std::max(options_.dcRestoreCorner, 0.0) * f0_ / fs_;
+        filter.design(segmentMagnitude(f0_, tau, etaLow), w0_, segmentMagnitude(fLossProbe_, tau, etaHigh), wLossProbe_, wRestore);
     }
 
     void designNode() noexcept
@@ -409,6 +427,7 @@ private:
     T nodeGain_ = T(1), halfAdmittance_ = T(1), halfTorsionAdmittance_ = T(1);
     bool plain_ = true;
     Pack4 lossB0_{}, lossA1_{}, lossState_{};
+    Pack4 top0_{}, top1_{}, shelfPole_{}, topState_{};
     Pack4 weightsBridgeOut_{}, weightsFinger_{}, weightsTorsionBridge_{}, weightsTorsionFinger_{};
     OnePoleLoss<T> lossBridge_, lossFinger_, lossTorsionBridge_, lossTorsionFinger_;
     DispersionChain<T> dispersion_;
