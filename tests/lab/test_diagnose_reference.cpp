@@ -98,7 +98,7 @@ void expectDiagnosis(const Outcome& o)
             EXPECT_FALSE(f.unidentified.count(name)) << name;
             const Tolerance tol = kTolerance.at(name);
             const double err = tol.relative ? std::abs(v[0] / t - 1.0) : std::abs(v[0] - t);
-            EXPECT_LE(err, tol.value) << name << " found " << v[0] << " hidden " << t;
+            EXPECT_LE(err, tol.value) << name << " found " << v[0] << " hidden " << t << "; tried:" << tried;
         }
 }
 } // namespace
