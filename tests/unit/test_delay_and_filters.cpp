@@ -52,6 +52,24 @@ TEST(DelayLine, FractionalDelayShiftsPhaseOfALowSine)
     EXPECT_LT(worst, 1e-5);
 }
 
+namespace {
+/// Delay (samples) of a slow sine through a fresh copy of the filter, from the last upward zero
+/// crossings of input and output within `samples`.
+double measuredPhaseDelay(OnePoleLoss<double> filter, double w, int samples)
+{
+    filter.reset();
+    double lastCrossIn = 0, lastCrossOut = 0, prevIn = 0, prevOut = 0;
+    for (int n = 0; n < samples; ++n) {
+        const double x = std::sin(w * n), y = filter.process(x);
+        if (prevIn < 0 && x >= 0) lastCrossIn = n - x / (x - prevIn);
+        if (prevOut < 0 && y >= 0) lastCrossOut = n - y / (y - prevOut);
+        prevIn = x;
+        prevOut = y;
+    }
+    return lastCrossOut - lastCrossIn;
+}
+} // namespace
+
 TEST(OnePoleLoss, HitsBothMagnitudeTargetsAndReportsItsPhaseDelay)
 {
     OnePoleLoss<double> f;
@@ -67,19 +85,7 @@ TEST(OnePoleLoss, HitsBothMagnitudeTargetsAndReportsItsPhaseDelay)
     // Phase delay checked against a measured delay of a slow sine through the filter.
     const double pd = f.phaseDelay(w1);
     EXPECT_GT(pd, 0.0);
-    double y = 0.0;
-    OnePoleLoss<double> g = f;
-    g.reset();
-    double lastCrossIn = 0, lastCrossOut = 0, prevIn = 0, prevOut = 0;
-    for (int n = 0; n < 20000; ++n) {
-        const double x = std::sin(w1 * n);
-        y = g.process(x);
-        if (prevIn < 0 && x >= 0) lastCrossIn = n - x / (x - prevIn);
-        if (prevOut < 0 && y >= 0) lastCrossOut = n - y / (y - prevOut);
-        prevIn = x;
-        prevOut = y;
-    }
-    EXPECT_NEAR(lastCrossOut - lastCrossIn, pd, 0.01);
+    EXPECT_NEAR(measuredPhaseDelay(f, w1, 20000), pd, 0.01);
 }
 
 // The DC shelf gives back at zero frequency what the low-pass loses there (a held deflection
@@ -103,18 +109,7 @@ TEST(OnePoleLoss, TheDcShelfRestoresUnitGainAtDcAndKeepsBothTargets)
     double y = 0;
     for (int n = 0; n < 200000; ++n) y = g.process(1.0);
     EXPECT_NEAR(y, 1.0, 2e-6);
-    // Phase delay against a slow sine's zero crossings.
-    double lastCrossIn = 0, lastCrossOut = 0, prevIn = 0, prevOut = 0;
-    g.reset();
-    for (int n = 0; n < 40000; ++n) {
-        const double x = std::sin(w1 * n);
-        y = g.process(x);
-        if (prevIn < 0 && x >= 0) lastCrossIn = n - x / (x - prevIn);
-        if (prevOut < 0 && y >= 0) lastCrossOut = n - y / (y - prevOut);
-        prevIn = x;
-        prevOut = y;
-    }
-    EXPECT_NEAR(lastCrossOut - lastCrossIn, restored.phaseDelay(w1), 0.01);
+    EXPECT_NEAR(measuredPhaseDelay(restored, w1, 40000), restored.phaseDelay(w1), 0.01); // against a slow sine
     // Rounded to float, the DC gain still never exceeds 1.
     OnePoleLoss<float> single;
     single.design(m1, w1, m2, w2, 0.5 * w1);

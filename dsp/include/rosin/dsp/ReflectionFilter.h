@@ -1,6 +1,7 @@
 // Reflection-function pieces for one waveguide segment (PHYSICS.md 1.2): a one-pole loss
-// filter fitted to the target damping with its DC restored by a low shelf, and an optional chain of first-order allpasses for
-// bending-stiffness dispersion. The sign inversion of a rigid end is applied by the caller.
+// filter fitted to the target damping (optionally with its DC restored by a low shelf), and an
+// optional chain of first-order allpasses for bending-stiffness dispersion. The sign inversion of
+// a rigid end is applied by the caller.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -25,7 +26,7 @@ inline double segmentMagnitude(double f, double tau, double eta) noexcept
 }
 
 /// One reflection's loss: a one-pole low-pass g (1 + p) / (1 + p z^-1) fitted to the target
-/// magnitudes at two frequencies, times a first-order low shelf S(z) = K (1 - zeta z^-1) / (1 -
+/// magnitudes at two frequencies, optionally times a first-order low shelf S(z) = K (1 - zeta z^-1) / (1 -
 /// rho z^-1) that gives back at DC what the low-pass loses there. A real string's damping vanishes
 /// at zero frequency (a held deflection does not relax); the low-pass alone lost about as much at
 /// DC as at f0, so a sticking bow's displacement crept back (the cello D's pre-slip ramp 4.5 %
