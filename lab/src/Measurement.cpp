@@ -321,6 +321,7 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
             info.format = SF_FORMAT_WAV | wavFormat;
             SNDFILE* sf = sf_open((tmp / rel).c_str(), SFM_WRITE, &info);
             if (!sf) throw LabError((tmp / rel).string() + ": cannot write WAV");
+            withoutPeakChunk(sf);
             if (wavFormat != SF_FORMAT_FLOAT && wavFormat != SF_FORMAT_DOUBLE) {
                 double peak = 0.0;
                 for (double v : s.signal) peak = std::max(peak, std::abs(v));
@@ -350,6 +351,7 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
             info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
             SNDFILE* sf = sf_open((tmp / rel).c_str(), SFM_WRITE, &info);
             if (!sf) throw LabError((tmp / rel).string() + ": cannot write WAV");
+            withoutPeakChunk(sf);
             std::vector<double> frames(2 * r.bridge.size());
             for (std::size_t i = 0; i < r.bridge.size(); ++i) {
                 frames[2 * i] = r.bridge[i];

@@ -46,6 +46,11 @@ void OutputSet::commit()
     committed_ = true;
 }
 
+void withoutPeakChunk(SNDFILE* file)
+{
+    sf_command(file, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
+}
+
 void writeWav(const fs::path& file, const std::vector<double>& samples, double sampleRate, WavEncoding encoding)
 {
     SF_INFO info{};
@@ -54,6 +59,7 @@ void writeWav(const fs::path& file, const std::vector<double>& samples, double s
     info.format = SF_FORMAT_WAV | (encoding == WavEncoding::Float32 ? SF_FORMAT_FLOAT : SF_FORMAT_PCM_24);
     SNDFILE* sf = sf_open(file.c_str(), SFM_WRITE, &info);
     if (!sf) throw LabError(file.string() + ": cannot write WAV (" + sf_strerror(nullptr) + ")");
+    withoutPeakChunk(sf);
     std::vector<double> data = samples;
     if (encoding == WavEncoding::Pcm24Normalized) {
         double peak = 0.0;

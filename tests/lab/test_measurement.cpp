@@ -3,13 +3,16 @@
 #include <gtest/gtest.h>
 #include <sndfile.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "rosin/lab/Classifier.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
+#include "rosin/lab/Output.h"
 #include "rosin/lab/Resample.h"
 #include "rosin/lab/Schumacher.h"
 #include "rosin/dsp.h"
@@ -44,6 +47,27 @@ std::string errorOf(const fs::path& folder)
         return e.what();
     }
     return "";
+}
+
+/// The ids of a RIFF file's top-level chunks, in order.
+std::vector<std::string> riffChunks(const fs::path& wav)
+{
+    std::ifstream in(wav, std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::vector<std::string> ids;
+    for (std::size_t at = 12; at + 8 <= bytes.size();) {
+        ids.emplace_back(bytes.data() + at, 4);
+        std::uint32_t size = 0;
+        for (int b = 3; b >= 0; --b) size = (size << 8) | static_cast<unsigned char>(bytes[at + 4 + static_cast<std::size_t>(b)]);
+        at += 8 + size + (size & 1u);
+    }
+    return ids;
+}
+
+std::string fileBytes(const fs::path& f)
+{
+    std::ifstream in(f, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 } // namespace
 
@@ -128,6 +152,36 @@ TEST(MeasurementSet, EverySampleFormatReadsBack)
         EXPECT_LT(worst, (format == SF_FORMAT_PCM_16 ? 1e-4 : 1e-6) * std::max(1.0, peak)) << format;
     }
     EXPECT_THROW(writeMeasurementSet(d / ("set" + std::to_string(SF_FORMAT_FLOAT)), set, SF_FORMAT_FLOAT), LabError);
+    fs::remove_all(d);
+}
+
+TEST(MeasurementSet, FloatWavsCarryNoTimeStampSoASetWritesTheSameBytesTwice)
+{
+    // libsndfile's PEAK chunk holds the time of writing: with it, seed 2043's regenerated
+    // two-ended recordings differed from the kept ones in two bytes while every sample agreed.
+    const fs::path d = freshDir("bytes");
+    SynthSpec spec = smallSpec(5);
+    spec.grid = 2;
+    SynthTruth truth;
+    const MeasurementSet set = synthesize(spec, truth);
+    ASSERT_FALSE(set.twoEnded.empty());
+    writeMeasurementSet(d / "a", set, SF_FORMAT_FLOAT);
+    writeMeasurementSet(d / "b", set, SF_FORMAT_FLOAT);
+    writeWav(d / "mono.wav", set.strokes[0].signal, set.sampleRate, WavEncoding::Float32);
+    std::vector<fs::path> wavs{d / "mono.wav"};
+    for (const auto& e : fs::recursive_directory_iterator(d / "a"))
+        if (e.path().extension() == ".wav") wavs.push_back(e.path());
+    ASSERT_EQ(wavs.size(), 1 + set.strokes.size() + set.twoEnded.size());
+    for (const fs::path& w : wavs) {
+        const std::vector<std::string> ids = riffChunks(w);
+        EXPECT_EQ(std::count(ids.begin(), ids.end(), "PEAK"), 0) << w;
+        EXPECT_EQ(std::count(ids.begin(), ids.end(), "data"), 1) << w;
+        if (w.filename() != "mono.wav") EXPECT_EQ(fileBytes(w), fileBytes(d / "b" / fs::relative(w, d / "a"))) << w;
+    }
+    const MeasurementSet back = readMeasurementSet(d / "a");
+    ASSERT_EQ(back.twoEnded[0].far.size(), set.twoEnded[0].far.size());
+    for (std::size_t i = 0; i < set.twoEnded[0].far.size(); ++i)
+        ASSERT_NEAR(back.twoEnded[0].far[i], set.twoEnded[0].far[i], 1e-6 * std::max(1.0, std::abs(set.twoEnded[0].far[i]))) << i;
     fs::remove_all(d);
 }
 

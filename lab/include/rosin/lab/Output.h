@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+struct sf_private_tag; // libsndfile's SNDFILE, for withoutPeakChunk without its header
+
 namespace rosin::lab {
 
 class OutputSet {
@@ -29,6 +31,10 @@ enum class WavEncoding {
     Float32,        ///< raw values (newtons): exact data for analysis
     Pcm24Normalized ///< peak-normalised to -1 dBFS, for listening
 };
+
+/// Leaves out the PEAK chunk libsndfile adds to float WAVs: it holds the time of writing, so
+/// the same samples written twice would differ. Call after sf_open, before any data.
+void withoutPeakChunk(sf_private_tag* file);
 
 /// Writes a mono WAV with libsndfile. Throws LabError naming the file.
 void writeWav(const std::filesystem::path& file, const std::vector<double>& samples, double sampleRate, WavEncoding encoding);
