@@ -49,25 +49,24 @@ std::string errorOf(const fs::path& folder)
     return "";
 }
 
+std::string fileBytes(const fs::path& f)
+{
+    std::ifstream in(f, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 /// The ids of a RIFF file's top-level chunks, in order.
 std::vector<std::string> riffChunks(const fs::path& wav)
 {
-    std::ifstream in(wav, std::ios::binary);
-    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string bytes = fileBytes(wav);
     std::vector<std::string> ids;
     for (std::size_t at = 12; at + 8 <= bytes.size();) {
-        ids.emplace_back(bytes.data() + at, 4);
+        ids.push_back(bytes.substr(at, 4));
         std::uint32_t size = 0;
         for (int b = 3; b >= 0; --b) size = (size << 8) | static_cast<unsigned char>(bytes[at + 4 + static_cast<std::size_t>(b)]);
         at += 8 + size + (size & 1u);
     }
     return ids;
-}
-
-std::string fileBytes(const fs::path& f)
-{
-    std::ifstream in(f, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 } // namespace
 
