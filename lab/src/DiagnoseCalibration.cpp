@@ -316,14 +316,13 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     });
 
 
-    // A ramp measures the scale times the string's static stiffness T / (beta (1 - beta) L), and the
+    // A ramp measures the scale times the string's slope T / (beta L), and the
     // manifest's tension and bow position are known only within the priors the fits give them:
-    // the interval carries that stiffness's range as well as the median's spread.
+    // the interval carries that slope's range as well as the median's spread.
     if (set.units == "V") {
         const auto& tension = parameterBounds().at("tension_scale");
         const auto& position = parameterBounds().at("beta_scale");
-        auto stiffness = [&](double t, double b) { return t * (1.0 - info.beta) / (b * (1.0 - b * info.beta)); };
-        const double softest = stiffness(tension.first, position.second), stiffest = stiffness(tension.second, position.first);
+        const double softest = relativeRampSlope(tension.first, position.second), stiffest = relativeRampSlope(tension.second, position.first);
         d.calibration.push_back({"scale_n_per_unit",
                                  "sensor scale (N per signal unit) from the pre-slip ramps; the interval spans the median's spread and the "
                                  "manifest tension and bow position within their priors",

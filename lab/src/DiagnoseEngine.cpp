@@ -162,6 +162,13 @@ double rollingSoftening(const dsp::BowedStringConfig& c)
     return 1.0 / (1.0 + 1.0 / (c.string.torsionImpedanceRatio * c.string.torsionSpeedRatio));
 }
 
+double relativeRampSlope(double tensionScale, double betaScale)
+{
+    // The bridge side's slope y / (beta L) times T; the string stays tuned to pitch, so the
+    // waveguide's ramps move by exactly this (a unit test).
+    return tensionScale / betaScale;
+}
+
 double Engine::recordedGain(const dsp::BowedStringConfig& c) const
 {
     // The ramps' scale made a rolling string's forces 1 / softening too large, so a rolling model

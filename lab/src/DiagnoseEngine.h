@@ -116,6 +116,9 @@ std::vector<RigUnknown> rigUnknowns(const EffectModel& m);
 /// Z_t c_t / (beta (1 - beta) L), so K_eff / K_transverse = 1 / (1 + Z_0 c / (Z_t c_t)); 1 without
 /// torsion. The pre-slip ramps of a rolling string are that much softer.
 double rollingSoftening(const dsp::BowedStringConfig& c);
+/// A pre-slip ramp's slope, bridge force per bow travel T / (beta L), at a tension and bow
+/// position off the manifest's (as scales of them) over the manifest string's.
+double relativeRampSlope(double tensionScale, double betaScale);
 
 class Engine;
 

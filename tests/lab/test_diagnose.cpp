@@ -434,6 +434,41 @@ TEST(DiagnoseScale, ARollingStringsRampsAreSofterByTheSeriesStiffness)
     }
 }
 
+// The ramps' scale is read with the manifest's string; the rig's tension and bow position are
+// known only within priors, and the scale's interval spans the ramp slopes they allow
+// (relativeRampSlope). The slope's factor against the waveguide's own ramps: a string tuned to
+// the same pitch at 4 % more tension, one bowed 3 % further from the bridge, and both moved.
+TEST(DiagnoseScale, AFittedTensionOrBowPositionMovesTheRampsByTheirSlope)
+{
+    constexpr double fs = 48000.0, beta = 0.0899;
+    auto ramp = [&](double tensionScale, double betaScale) {
+        rosin::dsp::BowedStringConfig c = modelWithEffects({}, {});
+        const double f0 = c.string.fundamental();
+        c.string.tension *= tensionScale;
+        c.string.massPerLength = c.string.tension / std::pow(2.0 * c.string.length * f0, 2.0); // tuned to pitch
+        rosin::dsp::BowedString<double> s;
+        s.prepare(fs, c);
+        std::vector<double> out(static_cast<std::size_t>(0.06 * fs));
+        for (std::size_t n = 0; n < out.size(); ++n) out[n] = s.processSample(2.0, 0.3 * static_cast<double>(n) / fs, beta * betaScale);
+        return out;
+    };
+    const std::vector<double> manifest = ramp(1.0, 1.0);
+    const double f0 = rosin::dsp::StringParams::celloD().fundamental();
+    EXPECT_EQ(diag::relativeRampSlope(1.0, 1.0), 1.0);
+    for (const auto& [tension, position] : {std::pair{1.04, 1.0}, std::pair{1.0, 1.03}, std::pair{0.96, 1.03}}) {
+        const std::vector<double> moved = ramp(tension, position);
+        double ab = 0, bb = 0;
+        for (auto j = static_cast<std::size_t>(2.0 / f0 * fs); j < moved.size(); ++j) {
+            ab += moved[j] * manifest[j];
+            bb += manifest[j] * manifest[j];
+        }
+        // T / (beta L): the waveguide's ramps move by it to 1e-4. The static stiffness at the bow,
+        // T / (beta (1 - beta) L), would be 0.3 % off at 3 % in bow position.
+        EXPECT_NEAR(ab / bb, diag::relativeRampSlope(tension, position), 1e-3) << "tension x" << tension << ", beta x" << position;
+        EXPECT_GT(std::abs(diag::relativeRampSlope(tension, position) - 1.0), 0.025);
+    }
+}
+
 // The one parameter table: each physical parameter belongs to a finding, each nuisance to the
 // calibration, and no name is both (the study's columns and the findings read the same table).
 TEST(DiagnoseParameters, PhysicalParametersBelongToFindingsAndNuisancesToTheCalibration)
