@@ -148,8 +148,14 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     d.baseline = current;
     const std::vector<ErrorParts> baselineTest = engine.errors(current, testSet);
     std::vector<ErrorParts> currentVal = engine.errors(current, valSet), currentTest = baselineTest;
-    d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, tension within +-5 % and bow position within "
-               "+-4 % of the manifest, fitted on the fit strokes with the baseline model; effects are fitted on top of them. Once thermal memory "
+    const auto prior = [&](const char* name, const std::optional<double>& stated) {
+        char text[32];
+        std::snprintf(text, sizeof text, "+-%.3g %%", 100.0 * (boundsOf(name, info).second - 1.0));
+        return std::string(text) + (stated ? " (the manifest's stated prior)" : "");
+    };
+    d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, tension within " + prior("tension_scale", info.tensionPrior) +
+                   " and bow position within " + prior("beta_scale", info.betaPrior) +
+                   " of the manifest, fitted on the fit strokes with the baseline model; effects are fitted on top of them. Once thermal memory "
                "is tried, the bow side's thermal effusivity (0.65-1.35 x 450) is a nuisance too.",
                "An effect is fitted on the fit strokes and named only when (1) its validation-error fall is the largest of the round "
                "with a 95 % paired-bootstrap interval above 0, (2) the fall is at least " + std::to_string(static_cast<int>(std::lround(100 * o.namingThreshold))) +
@@ -324,8 +330,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             all.effect = "joint";
             for (const auto& [name, value] : current.params) {
                 all.names.push_back(name);
-                all.lo.push_back(parameterBounds().at(name).first);
-                all.hi.push_back(parameterBounds().at(name).second);
+                all.lo.push_back(boundsOf(name, info).first);
+                all.hi.push_back(boundsOf(name, info).second);
                 all.start.push_back(value);
             }
             const auto x = diag::fit(engine, current, all, fitSet, all.start, o.maxEvaluations, 0.05, nullptr, false);
@@ -435,7 +441,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             Eigen::VectorXd x(static_cast<Eigen::Index>(names.size())), steps(x.size());
             for (std::size_t k = 0; k < names.size(); ++k) {
                 x[static_cast<Eigen::Index>(k)] = current.params.at(names[k]);
-                const auto [lo, hi] = parameterBounds().at(names[k]);
+                const auto [lo, hi] = boundsOf(names[k], info);
                 steps[static_cast<Eigen::Index>(k)] = 0.03 * (hi - lo);
             }
             auto residuals = [&](const Eigen::VectorXd& y) {
@@ -452,7 +458,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 const double v = x[kk], hw = 1.96 * std::sqrt(std::max(0.0, cov(kk, kk)));
                 // The fits never leave the search range, so neither does the interval; one that
                 // spans all of it (a direction with no curvature) marks a parameter not identified.
-                const auto [bottom, top] = parameterBounds().at(names[k]);
+                const auto [bottom, top] = boundsOf(names[k], info);
                 // (a parameter that cancels out of the model gets its whole range, whatever the curvature)
                 const bool canFix = identifiable(names[k]);
                 const double lo = canFix ? std::max(v - hw, bottom) : bottom, hi = canFix ? std::min(v + hw, top) : top;

@@ -171,6 +171,8 @@ StringInfo stringInfoOf(const MeasurementSet& set)
     const dsp::StringParams ref = dsp::StringParams::celloD();
     StringInfo info{set.f0, set.beta, 0, set.tension.value_or(ref.tension), set.length.value_or(ref.length)};
     info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
+    info.tensionPrior = set.tensionUncertainty;
+    info.betaPrior = set.betaUncertainty;
     return info;
 }
 
@@ -320,8 +322,8 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     // manifest's tension and bow position are known only within the priors the fits give them:
     // the interval carries that slope's range as well as the median's spread.
     if (set.units == "V") {
-        const auto& tension = parameterBounds().at("tension_scale");
-        const auto& position = parameterBounds().at("beta_scale");
+        const auto tension = boundsOf("tension_scale", info);
+        const auto position = boundsOf("beta_scale", info);
         const double softest = relativeRampSlope(tension.first, position.second), stiffest = relativeRampSlope(tension.second, position.first);
         d.calibration.push_back({"scale_n_per_unit",
                                  "sensor scale (N per signal unit) from the pre-slip ramps; the interval spans the median's spread and the "

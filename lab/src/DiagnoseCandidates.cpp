@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <tuple>
 
 #include "DiagnoseEngine.h"
 
@@ -186,9 +187,26 @@ EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector
 /// Fits the candidate's parameters on the given strokes. The error surface is rough (transients
 /// are chaotic), so a coarse grid over the bounds comes first and COBYLA refines from its best
 /// point on [0, 1]-scaled variables. `scan` = false skips the grid (warm starts).
-std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<std::size_t>& on,
+std::pair<double, double> boundsOf(const std::string& name, const StringInfo& info)
+{
+    std::optional<double> stated;
+    if (name == "tension_scale") stated = info.tensionPrior;
+    if (name == "beta_scale") stated = info.betaPrior;
+    if (stated) return {1.0 - *stated, 1.0 + *stated};
+    return parameterBounds().at(name);
+}
+
+std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& asBuilt, const std::vector<std::size_t>& on,
                         std::vector<double> start, int maxEval, double step, double* best, bool scan)
 {
+    // Every fit searches tension and bow position within the set's own priors, wherever the
+    // candidate was built.
+    Candidate c = asBuilt;
+    for (std::size_t k = 0; k < c.names.size(); ++k)
+        if (c.names[k] == "tension_scale" || c.names[k] == "beta_scale") {
+            std::tie(c.lo[k], c.hi[k]) = boundsOf(c.names[k], engine.info());
+            start[k] = std::clamp(start[k], c.lo[k], c.hi[k]);
+        }
     const std::size_t n = c.names.size();
     std::vector<double> x(n);
     for (std::size_t k = 0; k < n; ++k) x[k] = (start[k] - c.lo[k]) / (c.hi[k] - c.lo[k]);

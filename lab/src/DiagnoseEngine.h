@@ -23,6 +23,9 @@ namespace rosin::lab::diag {
 
 struct StringInfo {
     double f0, beta, z0, tension, length;
+    /// The manifest's stated priors of tension and bow position (a fraction either way); unset:
+    /// parameterBounds()'s.
+    std::optional<double> tensionPrior, betaPrior;
 };
 
 struct Prepared {
@@ -133,6 +136,9 @@ struct Candidate {
 
 /// Bounds of every parameter any extension has (for the joint refit).
 const std::map<std::string, std::pair<double, double>>& parameterBounds();
+/// A parameter's search range for this set: parameterBounds(), except tension and bow position
+/// where the manifest states how well it knows them.
+std::pair<double, double> boundsOf(const std::string& name, const StringInfo& info);
 /// False for a parameter no data can fix: h0 cancels out of the enhanced law when y(theta) is the
 /// inversion of steady sliding (docs/diagnosis.md), so whatever curvature the chaotic errors show
 /// along it is noise and its interval is its whole search range.
@@ -152,6 +158,7 @@ bool atNull(const std::string& effect, const std::map<std::string, double>& p);
 /// The model base with the candidate's effects added and its parameters set to x.
 EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x);
 /// Fits the candidate's parameters on the strokes `on`: a coarse grid, then COBYLA from its best point.
+/// Tension and bow position are searched within boundsOf() the engine's set, whatever the candidate says.
 std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<std::size_t>& on,
                         std::vector<double> start, int maxEval, double step, double* best = nullptr, bool scan = true);
 /// Paired bootstrap of the mean of before - after: {mean, low, high} (95 %).

@@ -203,6 +203,15 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
     if (str.contains("z0_kg_per_s")) set.z0 = positive(str, "z0_kg_per_s", manifest, "rig.string.");
     set.beta = positive(rig, "beta", manifest, "rig.");
     if (set.beta >= 0.5) fail(manifest, "rig.beta", "must be below 0.5");
+    // A prior narrower than 0.1 % leaves the fits nothing to move; one wider than 20 % is not a
+    // measured rig.
+    const auto uncertainty = [&](const json& obj, const char* key, const std::string& where) {
+        const double u = positive(obj, key, manifest, where);
+        if (u < 0.001 || u > 0.2) fail(manifest, where + key, "must be a fraction from 0.001 to 0.2 (0.01 is +-1 %)");
+        return u;
+    };
+    if (str.contains("tension_uncertainty")) set.tensionUncertainty = uncertainty(str, "tension_uncertainty", "rig.string.");
+    if (rig.contains("beta_uncertainty")) set.betaUncertainty = uncertainty(rig, "beta_uncertainty", "rig.");
     set.exciter = rig.value("exciter", "unknown");
     if (set.exciter != "bow" && set.exciter != "rod" && set.exciter != "unknown")
         fail(manifest, "rig.exciter", "must be \"bow\", \"rod\" or \"unknown\"");
@@ -366,8 +375,10 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
         if (set.length) str["length_m"] = *set.length;
         if (set.tension) str["tension_n"] = *set.tension;
         if (set.z0) str["z0_kg_per_s"] = *set.z0;
+        if (set.tensionUncertainty) str["tension_uncertainty"] = *set.tensionUncertainty;
         json rig{{"string", str}, {"beta", set.beta}, {"exciter", set.exciter},
                  {"sensor", {{"quantity", "bridge_force"}, {"units", set.units}, {"sample_rate_hz", set.sampleRate}}}};
+        if (set.betaUncertainty) rig["beta_uncertainty"] = *set.betaUncertainty;
         if (set.ambient) rig["ambient_c"] = *set.ambient;
         const json doc{{"format", "rosin-measurement/1"}, {"description", set.description}, {"rig", rig},
                        {"gesture", {{"kind", set.gesture}}}, {"transients", strokes}};

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -467,6 +468,41 @@ TEST(DiagnoseScale, AFittedTensionOrBowPositionMovesTheRampsByTheirSlope)
         EXPECT_NEAR(ab / bb, diag::relativeRampSlope(tension, position), 1e-3) << "tension x" << tension << ", beta x" << position;
         EXPECT_GT(std::abs(diag::relativeRampSlope(tension, position) - 1.0), 0.025);
     }
+}
+
+// Consistency check on a model-made set: a manifest that states the tension 3 % low. Within the
+// default prior (+-5 %) the calibration finds the string's tension; a lab that says it knows
+// its tension to +-1 % bounds it there, and the data then hold it at that end.
+TEST(DiagnoseCalibration, AManifestsStatedPriorBoundsTheTensionAndBowPosition)
+{
+    diag::StringInfo info;
+    Diagnosis d;
+    std::vector<diag::Prepared> strokes = preparedModelSet({}, 17, info, d);
+    const DiagnoseOptions o;
+    info.tension /= 1.03;
+    info.z0 /= 1.03;
+    std::vector<std::size_t> all(strokes.size());
+    std::iota(all.begin(), all.end(), std::size_t(0));
+    auto calibrate = [&](const diag::StringInfo& stated) {
+        const diag::Engine engine(strokes, stated, o.simRate, std::nullopt, false);
+        diag::Candidate cal = diag::candidate("calibration", {"tension_scale", "beta_scale"}, {1.0, 1.0});
+        cal.adds.clear();
+        return diag::fit(engine, EffectModel{}, cal, all, cal.start, o.maxEvaluations, 0.2);
+    };
+    const std::vector<double> free = calibrate(info);
+    EXPECT_NEAR(free[0], 1.03, 0.01) << "the default prior leaves room for the string's own tension";
+    EXPECT_NEAR(free[1], 1.0, 0.01);
+    diag::StringInfo known = info;
+    known.tensionPrior = 0.01;
+    known.betaPrior = 0.005;
+    EXPECT_EQ(diag::boundsOf("tension_scale", known), (std::pair{0.99, 1.01}));
+    EXPECT_EQ(diag::boundsOf("beta_scale", known), (std::pair{0.995, 1.005}));
+    EXPECT_EQ(diag::boundsOf("tension_scale", info), diag::parameterBounds().at("tension_scale"));
+    const std::vector<double> bounded = calibrate(known);
+    EXPECT_LE(bounded[0], 1.01);
+    EXPECT_GT(bounded[0], 1.005) << "pulled to the prior's end the data point to";
+    EXPECT_GE(bounded[1], 0.995);
+    EXPECT_LE(bounded[1], 1.005);
 }
 
 // The one parameter table: each physical parameter belongs to a finding, each nuisance to the

@@ -269,6 +269,39 @@ TEST(MeasurementSet, BrokenSetsAreRefusedNamingFileAndField)
     fs::remove_all(d);
 }
 
+// A lab that knows its tension and bow position says how well (rig.string.tension_uncertainty,
+// rig.beta_uncertainty, fractions either way): they survive a write and a read, an absent one
+// stays unset, and one no rig could mean is refused naming its field.
+TEST(MeasurementSet, TheRigsStatedPriorsRoundTripAndAnAbsurdOneIsRefused)
+{
+    const fs::path d = freshDir("priors");
+    SynthSpec spec = smallSpec(6);
+    spec.grid = 2;
+    SynthTruth truth;
+    MeasurementSet set = synthesize(spec, truth);
+    writeMeasurementSet(d / "none", set, SF_FORMAT_FLOAT);
+    const MeasurementSet plain = readMeasurementSet(d / "none");
+    EXPECT_FALSE(plain.tensionUncertainty.has_value());
+    EXPECT_FALSE(plain.betaUncertainty.has_value());
+    set.tensionUncertainty = 0.01;
+    set.betaUncertainty = 0.005;
+    writeMeasurementSet(d / "stated", set, SF_FORMAT_FLOAT);
+    const MeasurementSet back = readMeasurementSet(d / "stated");
+    ASSERT_TRUE(back.tensionUncertainty && back.betaUncertainty);
+    EXPECT_EQ(*back.tensionUncertainty, 0.01);
+    EXPECT_EQ(*back.betaUncertainty, 0.005);
+    set.tensionUncertainty = 0.5; // +-50 %: not a measured rig
+    writeMeasurementSet(d / "absurd", set, SF_FORMAT_FLOAT);
+    std::string e = errorOf(d / "absurd");
+    EXPECT_NE(e.find("manifest.json: field 'rig.string.tension_uncertainty' must be a fraction"), std::string::npos) << e;
+    set.tensionUncertainty.reset();
+    set.betaUncertainty = -0.01;
+    writeMeasurementSet(d / "negative", set, SF_FORMAT_FLOAT);
+    e = errorOf(d / "negative");
+    EXPECT_NE(e.find("field 'rig.beta_uncertainty'"), std::string::npos) << e;
+    fs::remove_all(d);
+}
+
 // A set may mix gestures (gesture.kind "mixed"): each transient names its own kind and that
 // kind's fields; they survive a write and a read, and a transient that names none is refused.
 TEST(MeasurementSet, MixedGesturesRoundTripAndAStrokeWithoutItsKindIsRefused)

@@ -46,6 +46,10 @@ struct MeasurementSet {
     double f0 = 0;
     std::optional<double> length, tension, z0;
     double beta = 0;
+    /// How well the lab knows its tension and bow position: the true value is within this
+    /// fraction of the stated one (rig.string.tension_uncertainty, rig.beta_uncertainty). Unset:
+    /// the diagnosis's own priors (+-5 %, +-4 %).
+    std::optional<double> tensionUncertainty, betaUncertainty;
     std::string exciter = "unknown";   ///< bow, rod or unknown
     std::optional<double> ambient;     ///< C
     std::string units = "N";           ///< N (calibrated) or V (scale unknown)
