@@ -184,9 +184,6 @@ EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector
     return m;
 }
 
-/// Fits the candidate's parameters on the given strokes. The error surface is rough (transients
-/// are chaotic), so a coarse grid over the bounds comes first and COBYLA refines from its best
-/// point on [0, 1]-scaled variables. `scan` = false skips the grid (warm starts).
 std::pair<double, double> boundsOf(const std::string& name, const StringInfo& info)
 {
     std::optional<double> stated;
@@ -196,6 +193,9 @@ std::pair<double, double> boundsOf(const std::string& name, const StringInfo& in
     return parameterBounds().at(name);
 }
 
+/// Fits the candidate's parameters on the given strokes. The error surface is rough (transients
+/// are chaotic), so a coarse grid over the bounds comes first and COBYLA refines from its best
+/// point on [0, 1]-scaled variables. `scan` = false skips the grid (warm starts).
 std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& asBuilt, const std::vector<std::size_t>& on,
                         std::vector<double> start, int maxEval, double step, double* best, bool scan)
 {
