@@ -329,9 +329,10 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             Candidate all;
             all.effect = "joint";
             for (const auto& [name, value] : current.params) {
+                const auto [lo, hi] = boundsOf(name, info);
                 all.names.push_back(name);
-                all.lo.push_back(boundsOf(name, info).first);
-                all.hi.push_back(boundsOf(name, info).second);
+                all.lo.push_back(lo);
+                all.hi.push_back(hi);
                 all.start.push_back(value);
             }
             const auto x = diag::fit(engine, current, all, fitSet, all.start, o.maxEvaluations, 0.05, nullptr, false);

@@ -400,38 +400,50 @@ TEST(DiagnoseSystematic, ARepeatedStrokeIsSimulatedOnceAndScoredAsOftenAsItAppea
     }
 }
 
+namespace {
+constexpr double kRampRate = 48000.0;
+constexpr double kCelloBeta = 0.0899; // the cello D bow position of the reference tests
+
+/// A slow Guettler stroke's first 60 ms (2 N, 0.3 m/s^2): the pre-slip ramp, at bow position beta.
+std::vector<double> slowRamp(const rosin::dsp::BowedStringConfig& c, double beta)
+{
+    rosin::dsp::BowedString<double> s;
+    s.prepare(kRampRate, c);
+    std::vector<double> out(static_cast<std::size_t>(0.06 * kRampRate));
+    for (std::size_t n = 0; n < out.size(); ++n) out[n] = s.processSample(2.0, 0.3 * static_cast<double>(n) / kRampRate, beta);
+    return out;
+}
+
+/// Least-squares factor of ramp over reference, from two periods to the end.
+double rampRatio(const std::vector<double>& ramp, const std::vector<double>& reference)
+{
+    const double f0 = rosin::dsp::StringParams::celloD().fundamental();
+    double ab = 0, bb = 0;
+    for (auto j = static_cast<std::size_t>(2.0 / f0 * kRampRate); j < ramp.size(); ++j) {
+        ab += ramp[j] * reference[j];
+        bb += reference[j] * reference[j];
+    }
+    return ab / bb;
+}
+} // namespace
+
 // A rolling string's quasi-static softening, as the diagnosis takes it (the bow point's transverse
 // stiffness in series with the torsional one), against the waveguide's own pre-slip ramps: a
 // slow Guettler stroke with torsion at Z_t/Z_0 = 2 and 4 and without, compared by least squares
 // over the ramp (from two periods to well before the first slip).
 TEST(DiagnoseScale, ARollingStringsRampsAreSofterByTheSeriesStiffness)
 {
-    auto ramp = [](const rosin::dsp::BowedStringConfig& c) {
-        rosin::dsp::BowedString<double> s;
-        constexpr double fs = 48000.0;
-        s.prepare(fs, c);
-        const double beta = 0.0899; // the cello D bow position of the reference tests
-        std::vector<double> out(static_cast<std::size_t>(0.06 * fs));
-        for (std::size_t n = 0; n < out.size(); ++n) out[n] = s.processSample(2.0, 0.3 * static_cast<double>(n) / fs, beta);
-        return out;
-    };
-    const std::vector<double> still = ramp(modelWithEffects({}, {}));
-    const double f0 = rosin::dsp::StringParams::celloD().fundamental();
+    const std::vector<double> still = slowRamp(modelWithEffects({}, {}), kCelloBeta);
     EXPECT_EQ(diag::rollingSoftening(modelWithEffects({}, {})), 1.0);
     for (const double zt : {2.0, 4.0}) {
         const rosin::dsp::BowedStringConfig c = modelWithEffects({"torsional_compliance"}, {{"zt_ratio", zt}});
-        const std::vector<double> rolled = ramp(c);
-        double ab = 0, bb = 0;
-        for (auto j = static_cast<std::size_t>(2.0 / f0 * 48000.0); j < rolled.size(); ++j) {
-            ab += rolled[j] * still[j];
-            bb += still[j] * still[j];
-        }
+        const double ratio = rampRatio(slowRamp(c, kCelloBeta), still);
         const double expected = 1.0 / (1.0 + 1.0 / (zt * c.string.torsionSpeedRatio));
         EXPECT_NEAR(diag::rollingSoftening(c), expected, 1e-12);
         // The formula says 8.8 % softer at Z_t/Z_0 = 2 and 4.6 % at 4; the waveguide's ramps are
         // about a fifth softer again (10.4 %, 5.5 %), the torsional losses letting the roll creep
         // over the 60 ms: within 2 % of the force, where no torsion at all would be 9 % off.
-        EXPECT_NEAR(ab / bb, expected, 0.02) << "Z_t/Z_0 " << zt << " ratio " << ab / bb;
+        EXPECT_NEAR(ratio, expected, 0.02) << "Z_t/Z_0 " << zt << " ratio " << ratio;
     }
 }
 
@@ -441,31 +453,20 @@ TEST(DiagnoseScale, ARollingStringsRampsAreSofterByTheSeriesStiffness)
 // the same pitch at 4 % more tension, one bowed 3 % further from the bridge, and both moved.
 TEST(DiagnoseScale, AFittedTensionOrBowPositionMovesTheRampsByTheirSlope)
 {
-    constexpr double fs = 48000.0, beta = 0.0899;
-    auto ramp = [&](double tensionScale, double betaScale) {
+    auto ramp = [](double tensionScale, double betaScale) {
         rosin::dsp::BowedStringConfig c = modelWithEffects({}, {});
         const double f0 = c.string.fundamental();
         c.string.tension *= tensionScale;
         c.string.massPerLength = c.string.tension / std::pow(2.0 * c.string.length * f0, 2.0); // tuned to pitch
-        rosin::dsp::BowedString<double> s;
-        s.prepare(fs, c);
-        std::vector<double> out(static_cast<std::size_t>(0.06 * fs));
-        for (std::size_t n = 0; n < out.size(); ++n) out[n] = s.processSample(2.0, 0.3 * static_cast<double>(n) / fs, beta * betaScale);
-        return out;
+        return slowRamp(c, kCelloBeta * betaScale);
     };
     const std::vector<double> manifest = ramp(1.0, 1.0);
-    const double f0 = rosin::dsp::StringParams::celloD().fundamental();
     EXPECT_EQ(diag::relativeRampSlope(1.0, 1.0), 1.0);
     for (const auto& [tension, position] : {std::pair{1.04, 1.0}, std::pair{1.0, 1.03}, std::pair{0.96, 1.03}}) {
-        const std::vector<double> moved = ramp(tension, position);
-        double ab = 0, bb = 0;
-        for (auto j = static_cast<std::size_t>(2.0 / f0 * fs); j < moved.size(); ++j) {
-            ab += moved[j] * manifest[j];
-            bb += manifest[j] * manifest[j];
-        }
         // T / (beta L): the waveguide's ramps move by it to 1e-4. The static stiffness at the bow,
         // T / (beta (1 - beta) L), would be 0.3 % off at 3 % in bow position.
-        EXPECT_NEAR(ab / bb, diag::relativeRampSlope(tension, position), 1e-3) << "tension x" << tension << ", beta x" << position;
+        EXPECT_NEAR(rampRatio(ramp(tension, position), manifest), diag::relativeRampSlope(tension, position), 1e-3)
+            << "tension x" << tension << ", beta x" << position;
         EXPECT_GT(std::abs(diag::relativeRampSlope(tension, position) - 1.0), 0.025);
     }
 }

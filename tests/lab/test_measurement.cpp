@@ -39,6 +39,15 @@ SynthSpec smallSpec(std::uint64_t seed)
     return s;
 }
 
+/// A 2x2 set synthesized from the seed: the least that exercises reading and writing.
+MeasurementSet tinySet(std::uint64_t seed)
+{
+    SynthSpec spec = smallSpec(seed);
+    spec.grid = 2;
+    SynthTruth truth;
+    return synthesize(spec, truth);
+}
+
 std::string errorOf(const fs::path& folder)
 {
     try {
@@ -135,10 +144,7 @@ TEST(MeasurementSet, SyntheticSetRoundTripsAndItsArtefactsAreUndone)
 TEST(MeasurementSet, EverySampleFormatReadsBack)
 {
     const fs::path d = freshDir("formats");
-    SynthSpec spec = smallSpec(4);
-    spec.grid = 2;
-    SynthTruth truth;
-    const MeasurementSet set = synthesize(spec, truth);
+    const MeasurementSet set = tinySet(4);
     for (int format : {SF_FORMAT_PCM_16, SF_FORMAT_PCM_32, SF_FORMAT_FLOAT, SF_FORMAT_DOUBLE}) {
         const fs::path f = d / ("set" + std::to_string(format));
         writeMeasurementSet(f, set, format);
@@ -159,10 +165,7 @@ TEST(MeasurementSet, FloatWavsCarryNoTimeStampSoASetWritesTheSameBytesTwice)
     // libsndfile's PEAK chunk holds the time of writing: with it, seed 2043's regenerated
     // two-ended recordings differed from the kept ones in two bytes while every sample agreed.
     const fs::path d = freshDir("bytes");
-    SynthSpec spec = smallSpec(5);
-    spec.grid = 2;
-    SynthTruth truth;
-    const MeasurementSet set = synthesize(spec, truth);
+    const MeasurementSet set = tinySet(5);
     ASSERT_FALSE(set.twoEnded.empty());
     writeMeasurementSet(d / "a", set, SF_FORMAT_FLOAT);
     writeMeasurementSet(d / "b", set, SF_FORMAT_FLOAT);
@@ -187,10 +190,7 @@ TEST(MeasurementSet, FloatWavsCarryNoTimeStampSoASetWritesTheSameBytesTwice)
 TEST(MeasurementSet, BrokenSetsAreRefusedNamingFileAndField)
 {
     const fs::path d = freshDir("broken");
-    SynthSpec spec = smallSpec(5);
-    spec.grid = 2;
-    SynthTruth truth;
-    const MeasurementSet set = synthesize(spec, truth);
+    const MeasurementSet set = tinySet(5);
     auto fresh = [&](const std::string& name) {
         const fs::path f = d / name;
         writeMeasurementSet(f, set, SF_FORMAT_FLOAT);
@@ -275,10 +275,7 @@ TEST(MeasurementSet, BrokenSetsAreRefusedNamingFileAndField)
 TEST(MeasurementSet, TheRigsStatedPriorsRoundTripAndAnAbsurdOneIsRefused)
 {
     const fs::path d = freshDir("priors");
-    SynthSpec spec = smallSpec(6);
-    spec.grid = 2;
-    SynthTruth truth;
-    MeasurementSet set = synthesize(spec, truth);
+    MeasurementSet set = tinySet(6);
     writeMeasurementSet(d / "none", set, SF_FORMAT_FLOAT);
     const MeasurementSet plain = readMeasurementSet(d / "none");
     EXPECT_FALSE(plain.tensionUncertainty.has_value());
@@ -307,10 +304,7 @@ TEST(MeasurementSet, TheRigsStatedPriorsRoundTripAndAnAbsurdOneIsRefused)
 TEST(MeasurementSet, MixedGesturesRoundTripAndAStrokeWithoutItsKindIsRefused)
 {
     const fs::path d = freshDir("mixed");
-    SynthSpec spec = smallSpec(6);
-    spec.grid = 2;
-    SynthTruth truth;
-    MeasurementSet set = synthesize(spec, truth);
+    MeasurementSet set = tinySet(6);
     set.gesture = "mixed";
     set.strokes[1].gesture = "exp_speed";
     set.strokes[1].v0 = 0.12;
