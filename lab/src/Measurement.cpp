@@ -324,24 +324,14 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
         json strokes = json::array();
         for (const auto& s : set.strokes) {
             const std::string rel = "transients/" + s.id + ".wav";
-            SF_INFO info{};
-            info.samplerate = static_cast<int>(std::lround(set.sampleRate));
-            info.channels = 1;
-            info.format = SF_FORMAT_WAV | wavFormat;
-            SNDFILE* sf = sf_open((tmp / rel).c_str(), SFM_WRITE, &info);
-            if (!sf) throw LabError((tmp / rel).string() + ": cannot write WAV");
-            withoutPeakChunk(sf);
             if (wavFormat != SF_FORMAT_FLOAT && wavFormat != SF_FORMAT_DOUBLE) {
                 double peak = 0.0;
                 for (double v : s.signal) peak = std::max(peak, std::abs(v));
-                if (peak >= 1.0) {
-                    sf_close(sf);
+                if (peak >= 1.0)
                     throw LabError(s.id + ": peak " + std::to_string(peak) + " " + set.units +
                                    " would clip a PCM file (full scale 1.0): use float WAV or units V");
-                }
             }
-            sf_write_double(sf, s.signal.data(), static_cast<sf_count_t>(s.signal.size()));
-            sf_close(sf);
+            writeWavFrames(tmp / rel, s.signal, 1, set.sampleRate, wavFormat);
             json t{{"id", s.id}, {"file", rel}, {"channel", 0}};
             if (set.gesture == "mixed") t["gesture"] = s.gesture;
             if (s.gesture == "guettler") { t["accel_m_s2"] = s.accel; t["force_n"] = s.force; }
@@ -354,20 +344,12 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
         if (!set.twoEnded.empty()) fs::create_directories(tmp / "two_ended");
         for (const auto& r : set.twoEnded) {
             const std::string rel = "two_ended/" + r.id + ".wav";
-            SF_INFO info{};
-            info.samplerate = static_cast<int>(std::lround(set.sampleRate));
-            info.channels = 2;
-            info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
-            SNDFILE* sf = sf_open((tmp / rel).c_str(), SFM_WRITE, &info);
-            if (!sf) throw LabError((tmp / rel).string() + ": cannot write WAV");
-            withoutPeakChunk(sf);
             std::vector<double> frames(2 * r.bridge.size());
             for (std::size_t i = 0; i < r.bridge.size(); ++i) {
                 frames[2 * i] = r.bridge[i];
                 frames[2 * i + 1] = r.far[i];
             }
-            sf_writef_double(sf, frames.data(), static_cast<sf_count_t>(r.bridge.size()));
-            sf_close(sf);
+            writeWavFrames(tmp / rel, frames, 2, set.sampleRate, SF_FORMAT_FLOAT);
             twoEnded.push_back({{"id", r.id}, {"bow_speed_m_s", r.bowSpeed}, {"force_n", r.force}, {"file", rel},
                                 {"bridge_channel", 0}, {"far_end_channel", 1}});
         }

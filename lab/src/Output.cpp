@@ -46,30 +46,33 @@ void OutputSet::commit()
     committed_ = true;
 }
 
-void withoutPeakChunk(SNDFILE* file)
+void writeWavFrames(const fs::path& file, const std::vector<double>& interleaved, int channels, double sampleRate, int sampleFormat)
 {
-    sf_command(file, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
+    SF_INFO info{};
+    info.samplerate = static_cast<int>(std::lround(sampleRate));
+    info.channels = channels;
+    info.format = SF_FORMAT_WAV | sampleFormat;
+    SNDFILE* sf = sf_open(file.c_str(), SFM_WRITE, &info);
+    if (!sf) throw LabError(file.string() + ": cannot write WAV (" + sf_strerror(nullptr) + ")");
+    sf_command(sf, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
+    const auto frames = static_cast<sf_count_t>(interleaved.size() / static_cast<std::size_t>(channels));
+    const sf_count_t written = sf_writef_double(sf, interleaved.data(), frames);
+    sf_close(sf);
+    if (written != frames) throw LabError(file.string() + ": short write (disk full?)");
 }
 
 void writeWav(const fs::path& file, const std::vector<double>& samples, double sampleRate, WavEncoding encoding)
 {
-    SF_INFO info{};
-    info.samplerate = static_cast<int>(std::lround(sampleRate));
-    info.channels = 1;
-    info.format = SF_FORMAT_WAV | (encoding == WavEncoding::Float32 ? SF_FORMAT_FLOAT : SF_FORMAT_PCM_24);
-    SNDFILE* sf = sf_open(file.c_str(), SFM_WRITE, &info);
-    if (!sf) throw LabError(file.string() + ": cannot write WAV (" + sf_strerror(nullptr) + ")");
-    withoutPeakChunk(sf);
-    std::vector<double> data = samples;
-    if (encoding == WavEncoding::Pcm24Normalized) {
-        double peak = 0.0;
-        for (double x : data) peak = std::max(peak, std::abs(x));
-        const double gain = peak > 0.0 ? std::pow(10.0, -1.0 / 20.0) / peak : 0.0;
-        for (double& x : data) x *= gain;
+    if (encoding == WavEncoding::Float32) {
+        writeWavFrames(file, samples, 1, sampleRate, SF_FORMAT_FLOAT);
+        return;
     }
-    const sf_count_t written = sf_write_double(sf, data.data(), static_cast<sf_count_t>(data.size()));
-    sf_close(sf);
-    if (written != static_cast<sf_count_t>(data.size())) throw LabError(file.string() + ": short write");
+    double peak = 0.0;
+    for (double x : samples) peak = std::max(peak, std::abs(x));
+    const double gain = peak > 0.0 ? std::pow(10.0, -1.0 / 20.0) / peak : 0.0;
+    std::vector<double> data = samples;
+    for (double& x : data) x *= gain;
+    writeWavFrames(file, data, 1, sampleRate, SF_FORMAT_PCM_24);
 }
 
 Progress::Progress(std::string label, bool enabled) : label_(std::move(label)), active_(enabled && isatty(2)) {}

@@ -6,8 +6,6 @@
 #include <string>
 #include <vector>
 
-struct sf_private_tag; // libsndfile's SNDFILE, for withoutPeakChunk without its header
-
 namespace rosin::lab {
 
 class OutputSet {
@@ -32,11 +30,13 @@ enum class WavEncoding {
     Pcm24Normalized ///< peak-normalised to -1 dBFS, for listening
 };
 
-/// Leaves out the PEAK chunk libsndfile adds to float WAVs: it holds the time of writing, so
-/// the same samples written twice would differ. Call after sf_open, before any data.
-void withoutPeakChunk(sf_private_tag* file);
+/// Writes a WAV of `channels` interleaved channels with libsndfile, `sampleFormat` one of
+/// SF_FORMAT_FLOAT, SF_FORMAT_PCM_24, ... Without libsndfile's PEAK chunk, which holds the time
+/// of writing: the same samples written twice give the same bytes. Throws LabError naming the file.
+void writeWavFrames(const std::filesystem::path& file, const std::vector<double>& interleaved, int channels, double sampleRate,
+                    int sampleFormat);
 
-/// Writes a mono WAV with libsndfile. Throws LabError naming the file.
+/// Writes a mono WAV. Throws LabError naming the file.
 void writeWav(const std::filesystem::path& file, const std::vector<double>& samples, double sampleRate, WavEncoding encoding);
 
 /// A progress bar on stderr when it is a terminal; silent when piped or redirected.
