@@ -43,6 +43,11 @@ struct WaveguideOptions {
     /// a stopped martele bow holds the string bent, and two strings need over 20 periods to
     /// reach Helmholtz at the default velocity.
     double dcRestoreCorner = 0.0;
+    /// The same for the two torsional reflections alone (0 = as dcRestoreCorner). Their loss
+    /// (Q_t 15-60) is the heaviest, so a held twist crept most: a rolling string under a sticking
+    /// bow went 3-5 % softer than its series stiffness in 0.2 s beyond the transverse creep. Off
+    /// by default; the diagnosis measured it and kept it off (docs/model.md).
+    double torsionDcRestoreCorner = 0.0;
 };
 
 template <typename T>
@@ -366,7 +371,8 @@ private:
                                         : lossFactor(f0_, f0_, params_.qLow, params_.qHigh, params_.qHighFrequency);
         const double etaHigh = torsional ? 1.0 / params_.qTorsion
                                          : lossFactor(fLossProbe_, f0_, params_.qLow, params_.qHigh, params_.qHighFrequency);
-        const double wRestore = 2.0 * std::numbers::pi * std::max(options_.dcRestoreCorner, 0.0) * f0_ / fs_;
+        const double corner = torsional && options_.torsionDcRestoreCorner > 0.0 ? options_.torsionDcRestoreCorner : options_.dcRestoreCorner;
+        const double wRestore = 2.0 * std::numbers::pi * std::max(corner, 0.0) * f0_ / fs_;
         filter.design(segmentMagnitude(f0_, tau, etaLow), w0_, segmentMagnitude(fLossProbe_, tau, etaHigh), wLossProbe_, wRestore);
     }
 
