@@ -296,6 +296,15 @@ bool intervalAtNull(const std::string& name, double lo, double hi)
     return false;
 }
 
+std::string noEffectValue(const std::string& name)
+{
+    if (name == "load_exponent") return "1 (Amontons)";
+    if (name == "shift_k") return "0 K";
+    if (name == "zt_ratio") return "7.5 or more (a roll too weak to see)";
+    if (name == "p") return "0.03 or less (no rate dependence)";
+    return "";
+}
+
 bool movedToNull(const Finding& f, const std::map<std::string, double>& now)
 {
     for (const auto& [name, v] : f.parameters) {

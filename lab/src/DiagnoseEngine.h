@@ -77,6 +77,18 @@ constexpr double kShiftPerEffusivity = 18.0;
 /// The report's paragraph saying so, with the shift the calibrated effusivity could equally be;
 /// empty when the effusivity was not calibrated or a shift is in the final model.
 std::string shiftOrEffusivityNote(const Diagnosis& d);
+/// The value a parameter takes where its effect is absent, in words ("" when it has none).
+std::string noEffectValue(const std::string& name);
+/// True when the reported 95 % interval (statistical, rig unknowns and the studies' model
+/// discrepancy) stays clear of the no-effect value; parameters without one count as clear.
+bool clearOfNoEffect(const Finding& f, const std::string& name);
+/// The c_t / c the lab's models take for a rolling string (the data do not fix it).
+double assumedTorsionSpeedRatio();
+/// A rolling string's softening of the bow point (rollingSoftening) in the lab's model at this Z_t/Z_0.
+double softeningAt(double ztRatio);
+/// What a finding's numbers can and cannot say beyond its table, in plain words for report.md:
+/// a reported interval that reaches the no-effect value, and what a torsion's Z_t/Z_0 rests on.
+std::string findingCaveats(const Finding& f);
 
 /// A finding's evidence in plain words: which part of the comparison the extension mended most.
 std::string describe(const std::string& effect, const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after,

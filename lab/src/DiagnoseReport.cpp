@@ -13,6 +13,7 @@
 #include "rosin/lab/Figures.h"
 #include "rosin/lab/Guettler.h"
 #include "rosin/lab/Plot.h"
+#include "rosin/lab/SynthData.h"
 
 namespace rosin::lab {
 namespace fs = std::filesystem;
@@ -185,6 +186,39 @@ std::string shiftOrEffusivityNote(const Diagnosis& d)
            "less: -16.8 K looked like 0.8), and these data do not choose between the two.\n\n";
 }
 
+bool clearOfNoEffect(const Finding& f, const std::string& name)
+{
+    const auto [lo, hi] = reportedInterval(f, name);
+    return !intervalAtNull(name, lo, hi);
+}
+
+double assumedTorsionSpeedRatio() { return modelWithEffects({"torsional_compliance"}, {}).string.torsionSpeedRatio; }
+
+double softeningAt(double ztRatio) { return rollingSoftening(modelWithEffects({"torsional_compliance"}, {{"zt_ratio", ztRatio}})); }
+
+std::string findingCaveats(const Finding& f)
+{
+    std::string text;
+    for (const auto& [name, v] : f.parameters) {
+        if (noEffectValue(name).empty() || clearOfNoEffect(f, name)) continue;
+        const auto [lo, hi] = reportedInterval(f, name);
+        text += "The rules named it on this set's own scatter, but once the model discrepancy the studies measured is counted, " + name +
+                "'s 95 % interval (" + fmt(lo) + " – " + fmt(hi) + ") reaches its no-effect value, " + noEffectValue(name) +
+                ": the data favour the effect without ruling out its absence. ";
+    }
+    if (const auto zt = f.parameters.find("zt_ratio"); zt != f.parameters.end()) {
+        const auto [lo, hi] = reportedInterval(f, "zt_ratio");
+        text += "What the ramps and first slips fix is how much softer the rolling string makes the bow point: a factor s = " +
+                fmt(softeningAt(zt->second[0]), "%.3f") + " (" + fmt(softeningAt(lo), "%.3f") + " – " + fmt(softeningAt(hi), "%.3f") +
+                "), the transverse stiffness in series with Z_t c_t against Z_0 c. Z_t/Z_0 follows from it with the torsional wave speed "
+                "taken as c_t = " + fmt(assumedTorsionSpeedRatio(), "%.2g") + " c; strings measure about 4.5-6, and Z_t/Z_0 moves in inverse proportion to "
+                "c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0). The rig's own tension and bow position enter s the same way, "
+                "within their priors. ";
+    }
+    if (!text.empty()) text.pop_back();
+    return text;
+}
+
 } // namespace diag
 
 namespace {
@@ -250,6 +284,11 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             if (f.curvature.count(name)) params[name]["ci95_curvature"] = f.curvature.at(name);
             if (f.halves.count(name)) params[name]["drive_halves"] = f.halves.at(name);
             params[name]["identified"] = !f.unidentified.count(name);
+            if (!diag::noEffectValue(name).empty()) params[name]["clear_of_no_effect"] = diag::clearOfNoEffect(f, name);
+            if (name == "zt_ratio") {
+                params[name]["torsion_speed_ratio_assumed"] = diag::assumedTorsionSpeedRatio();
+                params[name]["rolling_softening"] = {{"value", diag::softeningAt(v[0])}, {"ci95", {diag::softeningAt(lo), diag::softeningAt(hi)}}};
+            }
         }
         findings.push_back({{"effect", f.effect}, {"evidence", f.evidence}, {"parameters", params},
                             {"heldout_error_before", f.heldoutBefore}, {"heldout_error_after", f.heldoutAfter}});
@@ -365,6 +404,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             md << "| " << name << " | " << fmt(v[0]) << " | " << fmt(lo) << " – " << fmt(hi) << " | " << fmt(v[1]) << " – " << fmt(v[2]) << " | "
                << range(f.curvature, name, " – ") << " | " << range(f.halves, name, " / ") << " | " << range(f.systematic, name, " / ") << " | " << (f.discrepancy.count(name) ? fmt(f.discrepancy.at(name)) : std::string("-")) << " |\n";
         }
+        if (const std::string caveats = diag::findingCaveats(f); !caveats.empty()) md << "\n" << caveats << "\n";
         for (const auto& name : f.unidentified)
             md << "\n" << name << " is not identified: the errors do not change along it at the fit (no curvature), so its "
                << "interval is its whole search range and its value is whatever the search stopped at.\n";

@@ -597,3 +597,48 @@ TEST(DiagnoseConsistencyLong, RandomHiddenEffectsOverSeveralSeeds)
         check({effects, seed, seed % 2 ? 44100.0 : 48000.0, seed % 3 == 0, true});
     }
 }
+
+// The reported interval counts the model discrepancy the studies measured. Where it reaches the
+// no-effect value the report says the data favour the effect without ruling out its absence; a
+// torsion's report gives the softening the data fix and the c_t/c its Z_t/Z_0 rests on.
+TEST(DiagnoseParameters, TheReportSaysWhenTheModelDiscrepancyReachesNoEffect)
+{
+    const auto npos = std::string::npos;
+    Finding weak;
+    weak.effect = "torsional_compliance";
+    weak.parameters["zt_ratio"] = {4.3, 3.9, 4.7};
+    weak.discrepancy["zt_ratio"] = 1.96 * 0.53 * 4.3; // reported top 4.3 + 4.5, past 7.5
+    EXPECT_FALSE(diag::clearOfNoEffect(weak, "zt_ratio"));
+    EXPECT_NE(diag::findingCaveats(weak).find("reaches its no-effect value, 7.5 or more"), npos) << diag::findingCaveats(weak);
+
+    Finding strong = weak;
+    strong.parameters["zt_ratio"] = {1.5, 1.4, 1.6};
+    strong.discrepancy["zt_ratio"] = 1.96 * 0.53 * 1.5; // top 1.5 + 1.56
+    EXPECT_TRUE(diag::clearOfNoEffect(strong, "zt_ratio"));
+    const std::string text = diag::findingCaveats(strong);
+    EXPECT_EQ(text.find("no-effect"), npos) << text;
+    // s = 1 / (1 + 1 / (Z_t/Z_0 c_t/c)), with the model's c_t/c
+    const double speed = diag::assumedTorsionSpeedRatio();
+    EXPECT_NEAR(speed, modelWithEffects({"torsional_compliance"}, {}).string.torsionSpeedRatio, 1e-12);
+    EXPECT_NEAR(diag::softeningAt(1.5), 1.0 / (1.0 + 1.0 / (1.5 * speed)), 1e-12);
+    char expected[32];
+    std::snprintf(expected, sizeof expected, "s = %.3f", diag::softeningAt(1.5));
+    EXPECT_NE(text.find(expected), npos) << text;
+    EXPECT_NE(text.find("c_t = 5.2 c"), npos) << text;
+
+    Finding contact;
+    contact.effect = "hertzian_contact";
+    contact.parameters["load_exponent"] = {0.93, 0.91, 0.95};
+    contact.discrepancy["load_exponent"] = 1.96 * 0.018; // top 0.93 + 0.04
+    EXPECT_TRUE(diag::clearOfNoEffect(contact, "load_exponent"));
+    EXPECT_EQ(diag::findingCaveats(contact), "");
+    contact.parameters["load_exponent"] = {0.97, 0.95, 0.99}; // top 1.01
+    EXPECT_FALSE(diag::clearOfNoEffect(contact, "load_exponent"));
+    EXPECT_NE(diag::findingCaveats(contact).find("1 (Amontons)"), npos);
+
+    Finding thermal; // r_A has no no-effect value: thermal memory is named by its fall, not its parameter
+    thermal.effect = "thermal_memory";
+    thermal.parameters["r_A"] = {1.0, 0.5, 1.5};
+    EXPECT_TRUE(diag::clearOfNoEffect(thermal, "r_A"));
+    EXPECT_EQ(diag::findingCaveats(thermal), "");
+}
