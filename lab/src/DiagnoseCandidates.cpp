@@ -298,6 +298,7 @@ bool intervalAtNull(const std::string& name, double lo, double hi)
 
 std::string noEffectValue(const std::string& name)
 {
+    // The values intervalAtNull tests, in words.
     if (name == "load_exponent") return "1 (Amontons)";
     if (name == "shift_k") return "0 K";
     if (name == "zt_ratio") return "7.5 or more (a roll too weak to see)";

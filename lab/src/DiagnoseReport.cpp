@@ -212,8 +212,8 @@ std::string findingCaveats(const Finding& f)
                 fmt(softeningAt(zt->second[0]), "%.3f") + " (" + fmt(softeningAt(lo), "%.3f") + " – " + fmt(softeningAt(hi), "%.3f") +
                 "), the transverse stiffness in series with Z_t c_t against Z_0 c. Z_t/Z_0 follows from it with the torsional wave speed "
                 "taken as c_t = " + fmt(assumedTorsionSpeedRatio(), "%.2g") + " c; strings measure about 4.5-6, and Z_t/Z_0 moves in inverse proportion to "
-                "c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0). The rig's own tension and bow position enter s the same way, "
-                "within their priors. ";
+                "c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0). The ramps also trade s one for one with the rig's tension "
+                "over bow position, which the fits know only within their priors. ";
     }
     if (!text.empty()) text.pop_back();
     return text;
