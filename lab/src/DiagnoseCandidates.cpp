@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <random>
 #include <tuple>
@@ -287,22 +288,32 @@ std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const st
 
 /// The no-effect value of an effect's parameter, which its interval must exclude to be named
 /// (thermal memory has none: its law differs from the friction curve in kind).
+namespace {
+constexpr double kUnseenRoll = 7.5;    // the torsion of a string rolling less than Z_t = 7.5 Z0 is not seen
+constexpr double kNoRateExponent = 0.03;
+} // namespace
+
 bool intervalAtNull(const std::string& name, double lo, double hi)
 {
     if (name == "load_exponent") return hi >= 1.0;
     if (name == "shift_k") return lo <= 0.0 && hi >= 0.0;
-    if (name == "zt_ratio") return hi >= 7.5; // the torsion of a string rolling less than Z_t = 7.5 Z0 is not seen
-    if (name == "p") return lo <= 0.03;
+    if (name == "zt_ratio") return hi >= kUnseenRoll;
+    if (name == "p") return lo <= kNoRateExponent;
     return false;
 }
 
 std::string noEffectValue(const std::string& name)
 {
     // The values intervalAtNull tests, in words.
+    auto number = [](double x) {
+        char b[16];
+        std::snprintf(b, sizeof b, "%g", x);
+        return std::string(b);
+    };
     if (name == "load_exponent") return "1 (Amontons)";
     if (name == "shift_k") return "0 K";
-    if (name == "zt_ratio") return "7.5 or more (a roll too weak to see)";
-    if (name == "p") return "0.03 or less (no rate dependence)";
+    if (name == "zt_ratio") return number(kUnseenRoll) + " or more (a roll too weak to see)";
+    if (name == "p") return number(kNoRateExponent) + " or less (no rate dependence)";
     return "";
 }
 

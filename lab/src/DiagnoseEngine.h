@@ -86,6 +86,8 @@ bool clearOfNoEffect(const Finding& f, const std::string& name);
 double assumedTorsionSpeedRatio();
 /// A rolling string's softening of the bow point (rollingSoftening) in the lab's model at this Z_t/Z_0.
 double softeningAt(double ztRatio);
+/// A named torsion's softening at its value and at the ends of its reported Z_t/Z_0 interval.
+std::array<double, 3> rollingSofteningOf(const Finding& f);
 /// What a finding's numbers can and cannot say beyond its table, in plain words for report.md:
 /// a reported interval that reaches the no-effect value, and what a torsion's Z_t/Z_0 rests on.
 std::string findingCaveats(const Finding& f);

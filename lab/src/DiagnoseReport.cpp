@@ -196,20 +196,27 @@ double assumedTorsionSpeedRatio() { return modelWithEffects({"torsional_complian
 
 double softeningAt(double ztRatio) { return rollingSoftening(modelWithEffects({"torsional_compliance"}, {{"zt_ratio", ztRatio}})); }
 
+std::array<double, 3> rollingSofteningOf(const Finding& f)
+{
+    const auto [lo, hi] = reportedInterval(f, "zt_ratio");
+    return {softeningAt(f.parameters.at("zt_ratio")[0]), softeningAt(lo), softeningAt(hi)};
+}
+
 std::string findingCaveats(const Finding& f)
 {
     std::string text;
     for (const auto& [name, v] : f.parameters) {
-        if (noEffectValue(name).empty() || clearOfNoEffect(f, name)) continue;
+        if (noEffectValue(name).empty()) continue;
         const auto [lo, hi] = reportedInterval(f, name);
+        if (!intervalAtNull(name, lo, hi)) continue;
         text += "The rules named it on this set's own scatter, but once the model discrepancy the studies measured is counted, " + name +
                 "'s 95 % interval (" + fmt(lo) + " – " + fmt(hi) + ") reaches its no-effect value, " + noEffectValue(name) +
                 ": the data favour the effect without ruling out its absence. ";
     }
-    if (const auto zt = f.parameters.find("zt_ratio"); zt != f.parameters.end()) {
-        const auto [lo, hi] = reportedInterval(f, "zt_ratio");
+    if (f.parameters.count("zt_ratio")) {
+        const auto [s, low, high] = rollingSofteningOf(f);
         text += "What the ramps and first slips fix is how much softer the rolling string makes the bow point: a factor s = " +
-                fmt(softeningAt(zt->second[0]), "%.3f") + " (" + fmt(softeningAt(lo), "%.3f") + " – " + fmt(softeningAt(hi), "%.3f") +
+                fmt(s, "%.3f") + " (" + fmt(low, "%.3f") + " – " + fmt(high, "%.3f") +
                 "), the transverse stiffness in series with Z_t c_t against Z_0 c. Z_t/Z_0 follows from it with the torsional wave speed "
                 "taken as c_t = " + fmt(assumedTorsionSpeedRatio(), "%.2g") + " c; strings measure about 4.5-6, and Z_t/Z_0 moves in inverse proportion to "
                 "c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0). The ramps also trade s one for one with the rig's tension "
@@ -287,7 +294,8 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             if (!diag::noEffectValue(name).empty()) params[name]["clear_of_no_effect"] = diag::clearOfNoEffect(f, name);
             if (name == "zt_ratio") {
                 params[name]["torsion_speed_ratio_assumed"] = diag::assumedTorsionSpeedRatio();
-                params[name]["rolling_softening"] = {{"value", diag::softeningAt(v[0])}, {"ci95", {diag::softeningAt(lo), diag::softeningAt(hi)}}};
+                const auto [s, low, high] = diag::rollingSofteningOf(f);
+                params[name]["rolling_softening"] = {{"value", s}, {"ci95", {low, high}}};
             }
         }
         findings.push_back({{"effect", f.effect}, {"evidence", f.evidence}, {"parameters", params},
