@@ -302,6 +302,13 @@ bool intervalAtNull(const std::string& name, double lo, double hi)
     return false;
 }
 
+double discrepancyHalfWidth(const DiagnoseOptions& o, const std::string& name, double value)
+{
+    const auto m = o.modelDiscrepancy.find(name);
+    if (m == o.modelDiscrepancy.end() || !(m->second > 0.0)) return 0.0;
+    return 1.96 * m->second * (discrepancyIsRelative(name) ? std::abs(value) : 1.0);
+}
+
 std::string noEffectValue(const std::string& name)
 {
     // The values intervalAtNull tests, in words.

@@ -179,6 +179,9 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
 std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after, int B, std::uint64_t seed);
 /// True when [lo, hi] reaches the parameter's no-effect value.
 bool intervalAtNull(const std::string& name, double lo, double hi);
+/// The 95 % half-width the studies' model discrepancy adds to a parameter at `value` (0 where
+/// the options give none): 1.96 standard deviations, a share of the value for r_A and zt_ratio.
+double discrepancyHalfWidth(const DiagnoseOptions& o, const std::string& name, double value);
 /// Rule 4 asked again of an earlier finding after a later joint refit moved its parameters to
 /// `now`: does the interval it was named with (the same half-width around the new value) reach
 /// the no-effect value?

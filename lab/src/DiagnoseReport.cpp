@@ -209,9 +209,9 @@ std::string findingCaveats(const Finding& f)
         if (noEffectValue(name).empty()) continue;
         const auto [lo, hi] = reportedInterval(f, name);
         if (!intervalAtNull(name, lo, hi)) continue;
-        text += "The rules named it on this set's own scatter, but once the model discrepancy the studies measured is counted, " + name +
-                "'s 95 % interval (" + fmt(lo) + " – " + fmt(hi) + ") reaches its no-effect value, " + noEffectValue(name) +
-                ": the data favour the effect without ruling out its absence. ";
+        text += "Rule 4 found it clear of no effect on its bootstrap refits and the model discrepancy, but with the curvature, the drive "
+                "halves and the rig unknowns counted too, " + name + "'s 95 % interval (" + fmt(lo) + " – " + fmt(hi) +
+                ") reaches its no-effect value, " + noEffectValue(name) + ": the data favour the effect without ruling out its absence. ";
     }
     if (f.parameters.count("zt_ratio")) {
         const auto [s, low, high] = rollingSofteningOf(f);
@@ -470,8 +470,9 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
           "to carries model mismatch the resamples do not show), then adds in quadrature, side by side, the moves the rig unknowns "
           "cause (contact radius 150 and 350 um, torsion at Z_t/Z_0 = 2: the Gauss-Newton move on the signed metric parts) and the "
           "model discrepancy that a study of reference sets measured (standard deviations:" << discrepancyText(o) << "). That interval is "
-          "how well the size is known; whether an effect is there at all is rule (4)'s, on the bootstrap refits, so a named shift "
-          "of a few kelvin can carry a reported interval that reaches 0 K. The floor is the "
+          "how well the size is known. Rule (4) asks the bootstrap refits' interval, widened by the same model discrepancy, to exclude "
+          "the no-effect value, so with the default discrepancy no shift under about 16 K is named; the curvature, the drive halves and "
+          "the rig unknowns can still widen a named finding's interval to the no-effect value, which the finding then says. The floor is the "
           "final model against itself with 1 % scatter of force and acceleration on the test strokes. "
        << d.simulations << " simulations in " << fmt(d.seconds, "%.1f") << " s.\n";
     for (const auto& w : d.warnings) md << "\nWarning: " << w << "\n";

@@ -550,6 +550,52 @@ TEST(DiagnoseConsistency, FindsHertzianContactAtAnotherRateWithAnotherReflection
 
 TEST(DiagnoseConsistency, FindsThermalMemoryWithARosinTemperatureShift) { check({{"rosin_temperature_shift"}, 25}); }
 
+// Rule 4 asks the interval the report prints, model discrepancy included, to exclude no effect.
+// The seed-25 set above hides a -19.9 K shift, named with the default discrepancy (8 K, a
+// half-width of about 16 K) and fitted at -23.7 K. Told that the model misses shifts by 15 K
+// (half-width 29 K), the same fit cannot prove the shift: it is not named, the trial says why
+// with its fitted value, and nothing else takes its place (FindsThermalMemoryWithARosin-
+// TemperatureShift names it on the same set with the default).
+TEST(DiagnoseConsistency, AShiftWhosePrintedIntervalReachesZeroIsNotNamed)
+{
+    SynthSpec spec;
+    spec.effects = {"rosin_temperature_shift"};
+    spec.seed = 25;
+    spec.grid = 8;
+    SynthTruth truth;
+    const MeasurementSet set = modelSetFromDisk(spec, truth);
+    ASSERT_NEAR(truth.params.at("shift_k"), -19.9, 0.1);
+    DiagnoseOptions o;
+    o.seed = 5;
+    o.modelDiscrepancy["shift_k"] = 15.0;
+    const Diagnosis d = diagnose(set, o);
+    std::vector<std::string> found;
+    for (const auto& f : d.findings) found.push_back(f.effect);
+    EXPECT_EQ(found, std::vector<std::string>{"thermal_memory"});
+    const auto refused = std::find_if(d.trials.begin(), d.trials.end(), [](const Trial& t) {
+        return t.effect == "rosin_temperature_shift" && t.verdict == "interval reaches the no-effect value once the model discrepancy is counted";
+    });
+    ASSERT_NE(refused, d.trials.end());
+    EXPECT_NEAR(refused->parameters.at("shift_k"), truth.params.at("shift_k"), 5.0);
+    // the shift's own scatter would have let it through: the discrepancy is what refused it
+    EXPECT_LT(std::abs(refused->parameters.at("shift_k")), diag::discrepancyHalfWidth(o, "shift_k", refused->parameters.at("shift_k")));
+    EXPECT_GT(std::abs(refused->parameters.at("shift_k")), diag::discrepancyHalfWidth(DiagnoseOptions{}, "shift_k", 0.0));
+}
+
+// The half-width rule 4 and the report add: 1.96 standard deviations, a share of the value for
+// r_A and Z_t/Z_0, absolute for the others, none where the options give 0.
+TEST(DiagnoseParameters, TheModelDiscrepancysHalfWidthIsRelativeOnlyForRAAndZt)
+{
+    DiagnoseOptions o;
+    o.modelDiscrepancy = {{"shift_k", 8.0}, {"zt_ratio", 0.5}, {"r_A", 0.1}, {"p", 0.0}};
+    EXPECT_NEAR(diag::discrepancyHalfWidth(o, "shift_k", -3.0), 15.68, 1e-9);
+    EXPECT_NEAR(diag::discrepancyHalfWidth(o, "shift_k", 30.0), 15.68, 1e-9);
+    EXPECT_NEAR(diag::discrepancyHalfWidth(o, "zt_ratio", 4.0), 3.92, 1e-9);
+    EXPECT_NEAR(diag::discrepancyHalfWidth(o, "r_A", -2.0), 0.392, 1e-9);
+    EXPECT_EQ(diag::discrepancyHalfWidth(o, "p", 0.4), 0.0);
+    EXPECT_EQ(diag::discrepancyHalfWidth(o, "load_exponent", 0.7), 0.0);
+}
+
 // A rosin shift and the bow side's effusivity (a nuisance within 300-600 W s^1/2 m^-2 K^-1) both
 // move the contact's temperature against the rosin's softening: on this set a -16.8 K shift is
 // matched within 4 % of the validation error by an effusivity of 0.8 x 450, below the naming

@@ -71,7 +71,9 @@ struct DiagnoseOptions {
     /// beyond its statistical and rig-unknown intervals, measured by `rosin study` on reference
     /// sets, pooled over the studies of seeds 2038-2040 (133 named parameters; one seed alone
     /// swung too much: docs/diagnosis-study.md). r_A's and zt_ratio's are relative, the others
-    /// absolute; it widens the reported interval (in quadrature) and never decides what is named.
+    /// absolute; it widens the reported interval (in quadrature), and rule 4 asks that interval,
+    /// bootstrap and discrepancy together, to exclude the no-effect value. 0 for a parameter
+    /// turns it off (rule 4 then asks the bootstrap interval alone).
     std::map<std::string, double> modelDiscrepancy{{"r_A", 0.064}, {"p", 0.073}, {"load_exponent", 0.018}, {"shift_k", 8.0}, {"zt_ratio", 0.53}};
     bool quiet = false;
 };
