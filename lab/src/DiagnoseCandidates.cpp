@@ -309,6 +309,25 @@ double discrepancyHalfWidth(const DiagnoseOptions& o, const std::string& name, d
     return 1.96 * m->second * (discrepancyIsRelative(name) ? std::abs(value) : 1.0);
 }
 
+std::optional<double> nameableEdge(const DiagnoseOptions& o, const std::string& name)
+{
+    if (noEffectValue(name).empty()) return std::nullopt;
+    // Scan the search range for values whose discrepancy interval alone stays clear of no effect,
+    // and keep the one nearest to it (the shift is two-sided: its edge is a magnitude).
+    const auto [lo, hi] = parameterBounds().at(name);
+    std::optional<double> edge;
+    constexpr int kSteps = 20000;
+    for (int k = 0; k <= kSteps; ++k) {
+        const double v = lo + (hi - lo) * k / kSteps;
+        const double w = discrepancyHalfWidth(o, name, v);
+        if (intervalAtNull(name, v - w, v + w)) continue;
+        const double size = name == "shift_k" ? std::abs(v) : v;
+        const bool largerIsWeaker = name == "zt_ratio" || name == "load_exponent";
+        if (!edge || (largerIsWeaker ? size > *edge : size < *edge)) edge = size;
+    }
+    return edge;
+}
+
 std::string noEffectValue(const std::string& name)
 {
     // The values intervalAtNull tests, in words.

@@ -182,6 +182,10 @@ bool intervalAtNull(const std::string& name, double lo, double hi);
 /// The 95 % half-width the studies' model discrepancy adds to a parameter at `value` (0 where
 /// the options give none): 1.96 standard deviations, a share of the value for r_A and zt_ratio.
 double discrepancyHalfWidth(const DiagnoseOptions& o, const std::string& name, double value);
+/// The weakest value rule 4 can name with the options' model discrepancy and no scatter at all:
+/// the least |shift| (K), the largest Z_t/Z_0 or load exponent, the least p; none for parameters
+/// without a no-effect value. The bootstrap's own width comes on top.
+std::optional<double> nameableEdge(const DiagnoseOptions& o, const std::string& name);
 /// Rule 4 asked again of an earlier finding after a later joint refit moved its parameters to
 /// `now`: does the interval it was named with (the same half-width around the new value) reach
 /// the no-effect value?

@@ -596,6 +596,23 @@ TEST(DiagnoseParameters, TheModelDiscrepancysHalfWidthIsRelativeOnlyForRAAndZt)
     EXPECT_EQ(diag::discrepancyHalfWidth(o, "load_exponent", 0.7), 0.0);
 }
 
+// The weakest values rule 4 can name with the shipped discrepancy and no scatter: |shift| 1.96 x
+// 8 K, Z_t/Z_0 where v (1 + 1.96 x 0.53) reaches 7.5, p 0.03 + 1.96 x 0.073, the load exponent
+// 1 - 1.96 x 0.018; r_A has no no-effect value. A smaller discrepancy lets weaker effects through.
+TEST(DiagnoseParameters, RuleFoursWeakestNameableValuesFollowTheModelDiscrepancy)
+{
+    const DiagnoseOptions shipped;
+    EXPECT_NEAR(*diag::nameableEdge(shipped, "shift_k"), 1.96 * 8.0, 0.01);
+    EXPECT_NEAR(*diag::nameableEdge(shipped, "zt_ratio"), 7.5 / (1.0 + 1.96 * 0.53), 0.01);
+    EXPECT_NEAR(*diag::nameableEdge(shipped, "p"), 0.03 + 1.96 * 0.073, 0.001);
+    EXPECT_NEAR(*diag::nameableEdge(shipped, "load_exponent"), 1.0 - 1.96 * 0.018, 0.001);
+    EXPECT_FALSE(diag::nameableEdge(shipped, "r_A").has_value());
+    DiagnoseOptions half = shipped;
+    for (auto& [name, sd] : half.modelDiscrepancy) sd *= 0.5;
+    EXPECT_NEAR(*diag::nameableEdge(half, "shift_k"), 1.96 * 4.0, 0.01);
+    EXPECT_NEAR(*diag::nameableEdge(half, "zt_ratio"), 7.5 / (1.0 + 1.96 * 0.265), 0.01);
+}
+
 // A rosin shift and the bow side's effusivity (a nuisance within 300-600 W s^1/2 m^-2 K^-1) both
 // move the contact's temperature against the rosin's softening: on this set a -16.8 K shift is
 // matched within 4 % of the validation error by an effusivity of 0.8 x 450, below the naming
