@@ -82,9 +82,7 @@ EffectModel removed(EffectModel m, const std::string& effect)
     }
     return m;
 }
-} // namespace
 
-namespace {
 /// "; with it no shift under 15.7 K, ... is named": the least sizes rule 4 leaves, in words.
 std::string nameableText(const DiagnoseOptions& o)
 {
@@ -402,10 +400,11 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 tested.push_back(std::move(w));
             }
             // An earlier finding whose parameter the joint refit moved to where its interval (the
-            // half-width it was named with) reaches the no-effect value fails rule 4 now.
+            // half-width it was named with, and the model discrepancy) reaches the no-effect value
+            // fails rule 4 now.
             const auto stale = std::find_if(tested.begin(), tested.end(), [&](const Without& w) {
                 return std::any_of(d.findings.begin(), d.findings.end(),
-                                   [&](const Finding& f) { return f.effect == w.effect && movedToNull(f, current.params); });
+                                   [&](const Finding& f) { return f.effect == w.effect && movedToNull(f, current.params, o); });
             });
             const auto weakest = stale != tested.end() ? stale
                                                        : std::min_element(tested.begin(), tested.end(), [](const Without& a, const Without& b) { return a.share < b.share; });

@@ -343,12 +343,12 @@ std::string noEffectValue(const std::string& name)
     return "";
 }
 
-bool movedToNull(const Finding& f, const std::map<std::string, double>& now)
+bool movedToNull(const Finding& f, const std::map<std::string, double>& now, const DiagnoseOptions& o)
 {
     for (const auto& [name, v] : f.parameters) {
         const auto at = now.find(name);
         if (at == now.end() || v.size() < 3) continue;
-        const double half = 0.5 * (v[2] - v[1]);
+        const double half = std::hypot(0.5 * (v[2] - v[1]), discrepancyHalfWidth(o, name, at->second));
         if (intervalAtNull(name, at->second - half, at->second + half)) return true;
     }
     return false;

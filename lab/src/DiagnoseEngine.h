@@ -187,9 +187,9 @@ double discrepancyHalfWidth(const DiagnoseOptions& o, const std::string& name, d
 /// without a no-effect value. The bootstrap's own width comes on top.
 std::optional<double> nameableEdge(const DiagnoseOptions& o, const std::string& name);
 /// Rule 4 asked again of an earlier finding after a later joint refit moved its parameters to
-/// `now`: does the interval it was named with (the same half-width around the new value) reach
-/// the no-effect value?
-bool movedToNull(const Finding& f, const std::map<std::string, double>& now);
+/// `now`: does the interval it was named with (the same bootstrap half-width around the new
+/// value, widened by the model discrepancy as rule 4 widens it) reach the no-effect value?
+bool movedToNull(const Finding& f, const std::map<std::string, double>& now, const DiagnoseOptions& o);
 /// How far `after` lies below `before`, as a share of `before` (0 when there is nothing to fall from).
 double relativeFall(double before, double after);
 /// Rule 2's comparisons of candidate `c` (fitted as `trial`) with the round's other candidates,

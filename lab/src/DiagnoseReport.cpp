@@ -471,7 +471,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
           "cause (contact radius 150 and 350 um, torsion at Z_t/Z_0 = 2: the Gauss-Newton move on the signed metric parts) and the "
           "model discrepancy that a study of reference sets measured (standard deviations:" << discrepancyText(o) << "). That interval is "
           "how well the size is known. Rule (4) asks the bootstrap refits' interval, widened by the same model discrepancy, to exclude "
-          "the no-effect value, so with the default discrepancy no shift under about 16 K is named; the curvature, the drive halves and "
+          "the no-effect value, so the discrepancy alone sets the weakest effect that can be named (the rules give it); the curvature, the drive halves and "
           "the rig unknowns can still widen a named finding's interval to the no-effect value, which the finding then says. The floor is the "
           "final model against itself with 1 % scatter of force and acceleration on the test strokes. "
        << d.simulations << " simulations in " << fmt(d.seconds, "%.1f") << " s.\n";

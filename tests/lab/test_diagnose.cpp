@@ -176,22 +176,32 @@ TEST(DiagnoseSystematic, TheGaussNewtonMoveUndoesALinearChangeAndLeavesFlatDirec
 // value, and a parameter the refit did not report is not judged.
 TEST(DiagnoseParameters, AnEarlierFindingMovedTowardNoEffectIsJudgedByTheIntervalItWasNamedWith)
 {
+    DiagnoseOptions bootstrapOnly;
+    bootstrapOnly.modelDiscrepancy.clear();
     Finding shift;
     shift.effect = "rosin_temperature_shift";
     shift.parameters["shift_k"] = {11.0, 6.0, 16.0};
-    EXPECT_TRUE(diag::movedToNull(shift, {{"shift_k", 1.8}, {"r_A", 0.9}}));
-    EXPECT_FALSE(diag::movedToNull(shift, {{"shift_k", 9.0}, {"r_A", 0.9}}));
-    EXPECT_TRUE(diag::movedToNull(shift, {{"shift_k", -3.0}}));
-    EXPECT_FALSE(diag::movedToNull(shift, {{"r_A", 0.9}}));
+    EXPECT_TRUE(diag::movedToNull(shift, {{"shift_k", 1.8}, {"r_A", 0.9}}, bootstrapOnly));
+    EXPECT_FALSE(diag::movedToNull(shift, {{"shift_k", 9.0}, {"r_A", 0.9}}, bootstrapOnly));
+    EXPECT_TRUE(diag::movedToNull(shift, {{"shift_k", -3.0}}, bootstrapOnly));
+    EXPECT_FALSE(diag::movedToNull(shift, {{"r_A", 0.9}}, bootstrapOnly));
+    // as rule 4 now judges it: the shipped 8 K discrepancy widens the half-width to 16.5 K
+    const DiagnoseOptions shipped;
+    EXPECT_TRUE(diag::movedToNull(shift, {{"shift_k", 9.0}, {"r_A", 0.9}}, shipped));
+    EXPECT_TRUE(diag::movedToNull(shift, {{"shift_k", 16.0}}, shipped));
+    EXPECT_FALSE(diag::movedToNull(shift, {{"shift_k", 17.0}}, shipped));
     Finding contact;
     contact.effect = "hertzian_contact";
     contact.parameters["load_exponent"] = {0.70, 0.64, 0.76};
-    EXPECT_TRUE(diag::movedToNull(contact, {{"load_exponent", 0.95}}));
-    EXPECT_FALSE(diag::movedToNull(contact, {{"load_exponent", 0.90}}));
+    EXPECT_TRUE(diag::movedToNull(contact, {{"load_exponent", 0.95}}, bootstrapOnly));
+    EXPECT_FALSE(diag::movedToNull(contact, {{"load_exponent", 0.90}}, bootstrapOnly));
+    EXPECT_FALSE(diag::movedToNull(contact, {{"load_exponent", 0.90}}, shipped)); // 0.90 + hypot(0.06, 0.035) < 1
+    EXPECT_TRUE(diag::movedToNull(contact, {{"load_exponent", 0.935}}, shipped)); // 0.935 + 0.070 reaches 1
+    EXPECT_FALSE(diag::movedToNull(contact, {{"load_exponent", 0.935}}, bootstrapOnly)); // 0.935 + 0.06 does not
     Finding thermal;
     thermal.effect = "thermal_memory";
     thermal.parameters["r_A"] = {1.0, 0.8, 1.2};
-    EXPECT_FALSE(diag::movedToNull(thermal, {{"r_A", 0.01}}));
+    EXPECT_FALSE(diag::movedToNull(thermal, {{"r_A", 0.01}}, shipped));
 }
 
 // Round 1's shift candidate (before any rate law) against the shift fitted beside a named one:
