@@ -82,23 +82,6 @@ EffectModel removed(EffectModel m, const std::string& effect)
     }
     return m;
 }
-
-/// "; with it no shift under 15.7 K, ... is named": the least sizes rule 4 leaves, in words.
-std::string nameableText(const DiagnoseOptions& o)
-{
-    std::string text;
-    const std::pair<const char*, const char*> words[] = {
-        {"shift_k", "no shift under %.3g K"}, {"zt_ratio", "no Z_t/Z_0 above %.3g"}, {"p", "no speed exponent under %.3g"}, {"load_exponent", "no load exponent above %.3g"}};
-    for (const auto& [name, format] : words) {
-        if (discrepancyHalfWidth(o, name, 1.0) <= 0.0) continue;
-        const auto edge = nameableEdge(o, name);
-        if (!edge) continue;
-        char b[64];
-        std::snprintf(b, sizeof b, format, *edge);
-        text += (text.empty() ? "" : ", ") + std::string(b);
-    }
-    return text.empty() ? std::string() : "; with it " + text + " can be named, whatever the scatter";
-}
 } // namespace
 
 Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const std::function<void(const std::string&, double)>& progress)
@@ -182,7 +165,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                    "must not have the other sign than round 1's shift candidate when that one was 10 K or more (else it stands in for the rate law's form), (3) it also lowers the error of the test strokes, "
                    "(4) the 95 % interval of its parameter excludes the no-effect value (exponent 1, shift 0 K, "
                    "Z_t/Z_0 >= 7.5, speed exponent <= 0.03), both the bootstrap refits' interval and that interval widened in quadrature "
-                   "by the model discrepancy the studies measured (the one the report prints" + nameableText(o) + "), and (5) refitted on the low- and on the high-drive half of the fit strokes "
+                   "by the model discrepancy the studies measured (the one the report prints" + nameableEdgesText(o) + "), and (5) refitted on the low- and on the high-drive half of the fit strokes "
                    "(bow acceleration; v0/tv for exp_speed and bow speed for exp_force strokes, each gesture split at its own median) it keeps away from the no-effect value with consistent values. Every candidate is fitted with the nuisances and the "
                    "parameters of effects already named free beside its own. A parameter fitted within 1 % of either end of its search range "
                    "(r_A 0.5-2, h0 0.3-1.2, p 0.1-0.8, load exponent 0.4-1.1, shift -30 to +30 K, Z_t/Z_0 0.7-8) is a stand-in and is not named.",
@@ -313,8 +296,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 // The interval the report will print carries the model's own error on rigs it does
                 // not describe; a finding whose printed interval reaches no effect is not proved,
                 // so it is not named (the studies' spurious shifts all had one: docs/diagnosis.md).
-                const double model = discrepancyHalfWidth(o, t.c.names[k], t.x[k]);
-                const double wide = std::hypot(hw, model);
+                const double wide = namingHalfWidth(o, t.c.names[k], t.x[k], hw);
                 atNullWithDiscrepancy = atNullWithDiscrepancy || intervalAtNull(t.c.names[k], t.x[k] - wide, t.x[k] + wide);
             }
             if (atNullInterval) { trial.verdict = "interval reaches the no-effect value"; continue; }

@@ -309,23 +309,44 @@ double discrepancyHalfWidth(const DiagnoseOptions& o, const std::string& name, d
     return 1.96 * m->second * (discrepancyIsRelative(name) ? std::abs(value) : 1.0);
 }
 
+double namingHalfWidth(const DiagnoseOptions& o, const std::string& name, double value, double bootstrapHalfWidth)
+{
+    return std::hypot(bootstrapHalfWidth, discrepancyHalfWidth(o, name, value));
+}
+
 std::optional<double> nameableEdge(const DiagnoseOptions& o, const std::string& name)
 {
     if (noEffectValue(name).empty()) return std::nullopt;
-    // Scan the search range for values whose discrepancy interval alone stays clear of no effect,
-    // and keep the one nearest to it (the shift is two-sided: its edge is a magnitude).
+    // Scan the search range for values that rule 4's interval with no scatter leaves clear of no
+    // effect, and keep the one nearest to it (the shift is two-sided: its edge is a magnitude).
     const auto [lo, hi] = parameterBounds().at(name);
+    const bool largerIsWeaker = name == "zt_ratio" || name == "load_exponent";
     std::optional<double> edge;
     constexpr int kSteps = 20000;
     for (int k = 0; k <= kSteps; ++k) {
         const double v = lo + (hi - lo) * k / kSteps;
-        const double w = discrepancyHalfWidth(o, name, v);
+        const double w = namingHalfWidth(o, name, v, 0.0);
         if (intervalAtNull(name, v - w, v + w)) continue;
         const double size = name == "shift_k" ? std::abs(v) : v;
-        const bool largerIsWeaker = name == "zt_ratio" || name == "load_exponent";
         if (!edge || (largerIsWeaker ? size > *edge : size < *edge)) edge = size;
     }
     return edge;
+}
+
+std::string nameableEdgesText(const DiagnoseOptions& o)
+{
+    std::string text;
+    const std::pair<const char*, const char*> words[] = {
+        {"shift_k", "no shift under %.3g K"}, {"zt_ratio", "no Z_t/Z_0 above %.3g"}, {"p", "no speed exponent under %.3g"}, {"load_exponent", "no load exponent above %.3g"}};
+    for (const auto& [name, format] : words) {
+        if (discrepancyHalfWidth(o, name, 1.0) <= 0.0) continue;
+        const auto edge = nameableEdge(o, name);
+        if (!edge) continue;
+        char b[64];
+        std::snprintf(b, sizeof b, format, *edge);
+        text += (text.empty() ? "" : ", ") + std::string(b);
+    }
+    return text.empty() ? std::string() : "; with it " + text + " can be named, whatever the scatter";
 }
 
 std::string noEffectValue(const std::string& name)
@@ -348,7 +369,7 @@ bool movedToNull(const Finding& f, const std::map<std::string, double>& now, con
     for (const auto& [name, v] : f.parameters) {
         const auto at = now.find(name);
         if (at == now.end() || v.size() < 3) continue;
-        const double half = std::hypot(0.5 * (v[2] - v[1]), discrepancyHalfWidth(o, name, at->second));
+        const double half = namingHalfWidth(o, name, at->second, 0.5 * (v[2] - v[1]));
         if (intervalAtNull(name, at->second - half, at->second + half)) return true;
     }
     return false;

@@ -182,10 +182,17 @@ bool intervalAtNull(const std::string& name, double lo, double hi);
 /// The 95 % half-width the studies' model discrepancy adds to a parameter at `value` (0 where
 /// the options give none): 1.96 standard deviations, a share of the value for r_A and zt_ratio.
 double discrepancyHalfWidth(const DiagnoseOptions& o, const std::string& name, double value);
+/// The half-width rule 4 judges a parameter at `value` by: its bootstrap refits' half-width and
+/// the model discrepancy's, in quadrature (the interval the report prints, before the curvature,
+/// the drive halves and the rig unknowns widen it).
+double namingHalfWidth(const DiagnoseOptions& o, const std::string& name, double value, double bootstrapHalfWidth);
 /// The weakest value rule 4 can name with the options' model discrepancy and no scatter at all:
 /// the least |shift| (K), the largest Z_t/Z_0 or load exponent, the least p; none for parameters
 /// without a no-effect value. The bootstrap's own width comes on top.
 std::optional<double> nameableEdge(const DiagnoseOptions& o, const std::string& name);
+/// "; with it no shift under 15.7 K, ... can be named, whatever the scatter": nameableEdge of every
+/// parameter with a model discrepancy, in words for the report's rules ("" when none has one).
+std::string nameableEdgesText(const DiagnoseOptions& o);
 /// Rule 4 asked again of an earlier finding after a later joint refit moved its parameters to
 /// `now`: does the interval it was named with (the same bootstrap half-width around the new
 /// value, widened by the model discrepancy as rule 4 widens it) reach the no-effect value?
