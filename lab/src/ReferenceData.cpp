@@ -97,18 +97,43 @@ const std::map<std::string, std::pair<double, double>>& referenceEffectPriors()
     return p;
 }
 
+namespace {
+void checkRigValue(const std::string& key, double value)
+{
+    const auto& pr = referenceRigPriors();
+    if (std::none_of(pr.begin(), pr.end(), [&](const RigPrior& r) { return r.key == key; }))
+        throw LabError("--rig-param: unknown rig value '" + key + "' (rosin synth-data --help lists them)");
+    if (!std::isfinite(value)) throw LabError("--rig-param: " + key + " must be a finite number");
+}
+} // namespace
+
+std::map<std::string, double> parseRigValues(const std::vector<std::string>& nameEqualsValue)
+{
+    std::map<std::string, double> rig;
+    for (const auto& kv : nameEqualsValue) {
+        const auto eq = kv.find('=');
+        if (eq == std::string::npos) throw LabError("--rig-param: expected NAME=VALUE, got '" + kv + "'");
+        double value = 0.0;
+        try {
+            std::size_t used = 0;
+            value = std::stod(kv.substr(eq + 1), &used);
+            if (used != kv.size() - eq - 1) throw std::invalid_argument("trailing text");
+        } catch (const std::exception&) {
+            throw LabError("--rig-param: '" + kv + "' has no number");
+        }
+        checkRigValue(kv.substr(0, eq), value);
+        rig[kv.substr(0, eq)] = value;
+    }
+    return rig;
+}
+
 MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress)
 {
     if (spec.grid < 2 || spec.grid > 60) throw LabError("--grid must be within 2..60");
     if (!(spec.outRate >= 8000 && spec.outRate <= 384000)) throw LabError("--rate must be within 8000..384000 Hz");
     if (spec.oversampling < 4 || spec.oversampling > 32) throw LabError("--oversampling must be within 4..32 (the reference runs at least 4x the file rate)");
     if (spec.units != "V" && spec.units != "N") throw LabError("--units must be V or N");
-    for (const auto& [key, value] : spec.rig) {
-        const auto& pr = referenceRigPriors();
-        if (std::none_of(pr.begin(), pr.end(), [&](const RigPrior& r) { return r.key == key; }))
-            throw LabError("--rig-param: unknown rig value '" + key + "' (rosin synth-data --help lists them)");
-        if (!std::isfinite(value)) throw LabError("--rig-param: " + key + " must be a finite number");
-    }
+    for (const auto& [key, value] : spec.rig) checkRigValue(key, value);
     std::mt19937_64 rng(spec.seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     truth = SynthTruth{};

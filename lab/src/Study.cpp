@@ -76,6 +76,7 @@ struct Scored {
     std::map<std::string, double> rig;
     double baseline = 0, final = 0;
     bool unexplained = false;
+    double overFloor = 0;      ///< the final error over the set's noise-and-chaos floor
 };
 
 std::string joined(const std::vector<std::string>& v)
@@ -188,6 +189,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     planJson = json{{"grid", o.grid}, {"seed", o.seed}, {"sets", planJson}};
     if (o.gesture != "guettler") planJson["gesture"] = o.gesture; // Guettler studies' plans stay as they were
     if (o.plan != 1) planJson["plan"] = o.plan;                    // and so do version-1 plans
+    if (!o.rig.empty()) planJson["rig"] = o.rig;                   // fixed rig values: part of the study
     // A folder resumes only the study it holds: sets are skipped by folder name, so a different
     // seed, size or grid would silently mix two studies.
     if (fs::exists(dir / "plan.json")) {
@@ -198,8 +200,8 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
         }
         if (before != planJson)
-            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture or plan version: a plan.json "
-                                                          "without \"plan\" is version 1, --plan 1); use a new folder");
+            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture, fixed rig values or plan version: "
+                                                          "a plan.json without \"plan\" is version 1, --plan 1); use a new folder");
     }
     fs::create_directories(dir / "sets");
     if (mpi.isRoot() && !fs::exists(dir / "plan.json")) std::ofstream(dir / "plan.json") << planJson.dump(1) << "\n";
@@ -237,6 +239,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         spec.grid = o.grid;
         spec.oversampling = o.oversampling;
         spec.gesture = o.gesture;
+        spec.rig = o.rig;
         if (o.gesture == "exp_force") spec.units = "N";
         if (!kept) {
             SynthTruth truth;
@@ -310,6 +313,7 @@ std::string scoreStudy(const fs::path& dir)
         s.baseline = d["gain"]["baseline"].get<double>();
         s.final = d["gain"]["final"].get<double>();
         s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
+        if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
         sets.push_back(std::move(s));
     }
     if (sets.empty()) throw LabError(dir.string() + ": no diagnosed sets to score");
@@ -329,7 +333,29 @@ std::string scoreStudy(const fs::path& dir)
     json summary;
     md << "# Diagnosis study: " << sets.size() << " reference sets\n\n";
     md << "Sets named exactly right (every hidden effect and nothing else): " << exact << " of " << sets.size() << ".\n";
-    md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n\n", nNull ? 100.0 * nullFp / nNull : 0.0);
+    md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
+    // What the models on the list could not explain, and how far above the sets' own floors.
+    int residuals = 0, nullResiduals = 0;
+    std::vector<double> overFloor;
+    for (const auto& s : sets) {
+        residuals += s.unexplained;
+        nullResiduals += s.unexplained && s.hidden.empty();
+        overFloor.push_back(s.overFloor);
+    }
+    std::sort(overFloor.begin(), overFloor.end());
+    md << "Unexplained residual reported on " << residuals << " of " << sets.size() << " sets (" << nullResiduals << " of the " << nNull
+       << " null sets); final error over the set's floor: median " << fmt("%.2f", overFloor[overFloor.size() / 2])
+       << fmt(", from %.2f", overFloor.front()) << fmt(" to %.2f.\n", overFloor.back());
+    json plan;
+    if (fs::exists(dir / "plan.json")) std::ifstream(dir / "plan.json") >> plan;
+    if (plan.contains("rig")) {
+        std::string fixed;
+        for (const auto& [k, v] : plan["rig"].items()) fixed += (fixed.empty() ? "" : ", ") + k + fmt(" = %.3g", v.get<double>());
+        md << "Rig values fixed in every set instead of drawn: " << fixed << ".\n";
+        summary["fixed_rig"] = plan["rig"];
+    }
+    md << "\n";
+    summary["unexplained_residual"] = {{"sets", residuals}, {"null_sets", nullResiduals}, {"median_over_floor", overFloor[overFloor.size() / 2]}};
     summary["sets"] = sets.size();
     summary["exact"] = exact;
     summary["null_sets"] = nNull;
@@ -480,7 +506,7 @@ std::string scoreStudy(const fs::path& dir)
     }
     // Per set.
     std::ofstream csv(dir / "study.csv");
-    csv << "set,seed,hidden,found,exact,baseline_error,final_error,unexplained";
+    csv << "set,seed,hidden,found,exact,baseline_error,final_error,unexplained,over_floor";
     for (const auto& p : physicalParameterNames()) csv << "," << p << "_true," << p << "_found," << p << "_ci_low," << p << "_ci_high";
     const std::vector<std::string> rigCols{"noise_n", "inharmonicity", "bridge_z0y", "headroom", "tension_error", "beta_error", "mu_level", "rod_effusivity"};
     for (const auto& r : rigCols) csv << "," << r;
@@ -492,7 +518,7 @@ std::string scoreStudy(const fs::path& dir)
         std::sort(h.begin(), h.end());
         std::sort(f.begin(), f.end());
         csv << s.index << "," << s.seed << "," << joined(s.hidden) << "," << joined(s.found) << "," << (h == f) << "," << s.baseline << ","
-            << s.final << "," << s.unexplained;
+            << s.final << "," << s.unexplained << "," << s.overFloor;
         for (const auto& p : physicalParameterNames()) {
             csv << "," << (s.truth.count(p) ? fmt("%.6g", s.truth.at(p)) : "");
             for (int k = 0; k < 3; ++k) csv << "," << (s.estimate.count(p) ? fmt("%.6g", s.estimate.at(p)[static_cast<std::size_t>(k)]) : "");
@@ -506,7 +532,8 @@ std::string scoreStudy(const fs::path& dir)
         md << "| " << s.index << " | " << hidden << " | " << found << (s.unexplained ? " (+ unexplained residual)" : "") << " | "
            << fmt("%.3f", s.baseline) << fmt(" -> %.3f", s.final) << " |\n";
         perSet.push_back({{"set", s.index}, {"seed", s.seed}, {"hidden", s.hidden}, {"found", s.found}, {"truth", s.truth},
-                          {"baseline_error", s.baseline}, {"final_error", s.final}, {"unexplained", s.unexplained}});
+                          {"baseline_error", s.baseline}, {"final_error", s.final}, {"unexplained", s.unexplained},
+                          {"over_floor", s.overFloor}});
     }
     std::ofstream(dir / "study.json") << json{{"summary", summary}, {"sets", perSet}}.dump(1) << "\n";
     std::ofstream(dir / "summary.md") << md.str();

@@ -93,6 +93,29 @@ TEST(ReferenceSynthData, FixedRigValuesAreKeptAndUnknownOnesRefused)
     EXPECT_THROW(synthesize(spec, truth), LabError);
 }
 
+// --rig-param of synth-data and study: NAME=VALUE, each name one the generator draws and each
+// value a finite number; anything else is refused naming the value, before a set is simulated.
+TEST(ReferenceSynthData, RigValuesFromTheCommandLineAreParsedOrRefusedByName)
+{
+    const auto rig = parseRigValues({"inharmonicity=1e-3", "bridge_z0y=0.25"});
+    ASSERT_EQ(rig.size(), 2u);
+    EXPECT_DOUBLE_EQ(rig.at("inharmonicity"), 1e-3);
+    EXPECT_DOUBLE_EQ(rig.at("bridge_z0y"), 0.25);
+    const auto refusal = [](const std::vector<std::string>& args) {
+        try {
+            parseRigValues(args);
+        } catch (const LabError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_NE(refusal({"stiffness=1e-3"}).find("unknown rig value 'stiffness'"), std::string::npos);
+    EXPECT_NE(refusal({"inharmonicity"}).find("expected NAME=VALUE"), std::string::npos);
+    EXPECT_NE(refusal({"inharmonicity=1e-3x"}).find("has no number"), std::string::npos);
+    EXPECT_NE(refusal({"inharmonicity=nan"}).find("inharmonicity must be a finite number"), std::string::npos);
+    EXPECT_NE(refusal({"bridge_z0y="}).find("has no number"), std::string::npos);
+}
+
 TEST(ReferenceSynthData, BrokenSteadySlidingFileIsNamedWithItsLine)
 {
     SynthTruth truth;

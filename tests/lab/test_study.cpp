@@ -179,6 +179,20 @@ TEST(Study, AFolderResumesOnlyTheStudyItHolds)
         EXPECT_NE(std::string(e.what()).find("--plan 1"), std::string::npos) << e.what();
     }
     EXPECT_FALSE(fs::exists(dir / "sets"));
+    // A rig value fixed in every set makes another study too (a stiff-string study is not the
+    // drawn-rig study of the same seed).
+    StudyOptions stiff = o;
+    stiff.rig = {{"inharmonicity", 1e-3}};
+    plan = json::array();
+    for (const StudySet& s : planStudy(o)) plan.push_back({{"index", s.index}, {"seed", s.seed}, {"effects", s.effects}});
+    std::ofstream(dir / "plan.json") << json{{"grid", o.grid}, {"seed", o.seed}, {"plan", 2}, {"sets", plan}}.dump(1);
+    try {
+        runStudy(dir, stiff);
+        FAIL() << "a drawn-rig folder was resumed with a fixed stiffness";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("fixed rig values"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir / "sets"));
     fs::remove_all(dir);
 }
 
@@ -229,6 +243,33 @@ TEST(Study, RunsOnlyThePickedSetsOfTheWholePlan)
 
 // Sets can be simulated on one occasion and diagnosed on another (a new diagnosis on the same
 // data): the second run diagnoses the kept set as it is and simulates nothing again.
+// `rosin study --rig-param`: the fixed value reaches every set's rig (its truth says so) and the
+// plan, so the folder is known for what it holds; the other rig values are still drawn.
+TEST(Study, AFixedRigValueReachesEverySetAndThePlan)
+{
+    const fs::path dir = freshDir("fixed-rig");
+    StudyOptions o;
+    o.sets = 2;
+    o.nulls = 1;
+    o.grid = 3;
+    o.seed = 12;
+    o.rig = {{"inharmonicity", 1e-3}};
+    o.generateOnly = true;
+    runStudy(dir, o);
+    json plan;
+    std::ifstream(dir / "plan.json") >> plan;
+    EXPECT_DOUBLE_EQ(plan["rig"]["inharmonicity"].get<double>(), 1e-3);
+    std::set<double> bridges;
+    for (int k = 0; k < 2; ++k) {
+        json truth;
+        std::ifstream(setDir(dir, k) / "truth.json") >> truth;
+        EXPECT_DOUBLE_EQ(truth["rig"]["inharmonicity"].get<double>(), 1e-3) << "set " << k;
+        bridges.insert(truth["rig"]["bridge_z0y"].get<double>());
+    }
+    EXPECT_EQ(bridges.size(), 2u) << "the values not fixed are drawn per set";
+    fs::remove_all(dir);
+}
+
 TEST(Study, GenerateOnlyKeepsTheSetsAndALaterRunDiagnosesThem)
 {
     const fs::path dir = freshDir("generate");
@@ -307,6 +348,38 @@ TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
 // 1 + tension_error, beta_scale against 1 + beta_error, rod_effusivity_scale against the rig's
 // rod effusivity over 450 (only sets with a thermal model calibrate it), the sensor scale against
 // the inverse of the generator's gain, with their intervals' coverage.
+// The residual's line in the summary: on how many sets (and nulls) the diagnosis reported what
+// no model on its list explains, and the final error over each set's floor (median, range).
+TEST(Study, CountsTheUnexplainedResidualsAndHowFarAboveTheirFloorsTheSetsAre)
+{
+    const fs::path dir = freshDir("residual");
+    const auto withFloor = [](json d, double overFloor, bool unexplained) {
+        d["floor"] = {{"final_over_floor", overFloor}};
+        if (unexplained) d["unexplained_residual"] = {{"ratio", overFloor}};
+        return d;
+    };
+    const json none = diagnosis(json::array({{{"effect", "none"}}}));
+    writeSet(dir, 0, {{"effects", json::array()}, {"params", json::object()}}, withFloor(none, 1.5, false));
+    writeSet(dir, 1, {{"effects", json::array()}, {"params", json::object()}}, withFloor(none, 9.0, true));
+    writeSet(dir, 2, {{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.2}}}},
+             withFloor(thermalDiagnosis(1.18, 1.1, 1.3, json::object()), 4.0, true));
+    std::ofstream(dir / "plan.json") << json{{"rig", {{"inharmonicity", 1e-3}}}}.dump();
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    const json& r = study["summary"]["unexplained_residual"];
+    EXPECT_EQ(r["sets"], 2);
+    EXPECT_EQ(r["null_sets"], 1);
+    EXPECT_DOUBLE_EQ(r["median_over_floor"].get<double>(), 4.0);
+    EXPECT_NE(md.find("Unexplained residual reported on 2 of 3 sets (1 of the 2 null sets); final error over the set's floor: median 4.00, "
+                      "from 1.50 to 9.00."),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("Rig values fixed in every set instead of drawn: inharmonicity = 0.001."), std::string::npos) << md;
+    EXPECT_DOUBLE_EQ(study["sets"][1]["over_floor"].get<double>(), 9.0);
+    fs::remove_all(dir);
+}
+
 TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
 {
     const fs::path dir = freshDir("nuisances");

@@ -6,6 +6,7 @@
 
 #include "rosin/lab/Distributed.h"
 #include "rosin/lab/Output.h"
+#include "rosin/lab/ReferenceData.h"
 #include "rosin/lab/Study.h"
 #include "rosin/lab/SynthData.h"
 
@@ -17,6 +18,7 @@ struct StudyCommand {
     StudyOptions options;
     std::string out = "study";
     bool scoreOnly = false;
+    std::vector<std::string> rigValues;
 
     CLI::App* add(CLI::App& app)
     {
@@ -39,6 +41,9 @@ struct StudyCommand {
             ->check(CLI::IsMember({"guettler", "exp_speed", "exp_force", "mixed"}))->capture_default_str();
         cmd->add_option("--oversampling", options.oversampling, "Reference simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         cmd->add_option("--diagnose-seed", options.diagnose.seed, "Seed of each diagnosis's split and bootstraps")->capture_default_str();
+        cmd->add_option("--rig-param", rigValues,
+                        "Reference rig value NAME=VALUE fixed in every set instead of drawn (names: rosin synth-data --help), e.g. "
+                        "inharmonicity=1e-3 for strongly stiff strings");
         cmd->add_flag("--keep-sets", options.keepSets, "Keep the generated WAV sets");
         cmd->add_option("--only", options.only, "Run only these sets (indices, e.g. 3,13; the folder's plan stays the whole study)")->delimiter(',')->check(CLI::NonNegativeNumber);
         cmd->add_option("--hiding", options.hiding, "Run only the sets that hide this effect")->check(CLI::IsMember(effectIds()));
@@ -51,6 +56,7 @@ struct StudyCommand {
 
     int run()
     {
+        options.rig = parseRigValues(rigValues);
         if (!scoreOnly) {
             Progress progress("study", !options.quiet && Distributed::instance().isRoot());
             runStudy(out, options, [&](const std::string&, double x) { progress.update(x); });

@@ -90,15 +90,7 @@ struct SynthDataCommand {
                 throw LabError("--param: '" + kv + "' has no number");
             }
         }
-        for (const auto& kv : rigParams) {
-            const auto eq = kv.find('=');
-            if (eq == std::string::npos) throw LabError("--rig-param: expected NAME=VALUE, got '" + kv + "'");
-            try {
-                synth.rig[kv.substr(0, eq)] = std::stod(kv.substr(eq + 1));
-            } catch (const std::exception&) {
-                throw LabError("--rig-param: '" + kv + "' has no number");
-            }
-        }
+        synth.rig = parseRigValues(rigParams);
         if (fs::exists(synthOut)) throw LabError(synthOut + ": already exists (choose a new folder)");
         const std::map<std::string, int> formats{{"pcm16", SF_FORMAT_PCM_16}, {"pcm24", SF_FORMAT_PCM_24},
                                                  {"pcm32", SF_FORMAT_PCM_32}, {"float", SF_FORMAT_FLOAT},

@@ -27,6 +27,10 @@ struct RigPrior {
 /// Every rig value the reference generator draws, in the order it draws them.
 const std::vector<RigPrior>& referenceRigPriors();
 
+/// NAME=VALUE strings (`--rig-param`) to fixed rig values, each name one of referenceRigPriors()
+/// and each value finite: a clear error otherwise, before anything is simulated.
+std::map<std::string, double> parseRigValues(const std::vector<std::string>& nameEqualsValue);
+
 /// Priors of the hidden effects' parameters in reference sets. They reach weak effects close
 /// to none: shifts from 1 K, load exponents up to 0.95, Z_t/Z_0 up to 8.
 const std::map<std::string, std::pair<double, double>>& referenceEffectPriors();

@@ -28,6 +28,9 @@ struct StudyOptions {
     /// The sets' strokes (synth-data --gesture): guettler, exp_speed, exp_force (then
     /// calibrated in newtons: rising-force strokes alone cannot set a volt scale) or mixed.
     std::string gesture = "guettler";
+    /// Rig values fixed in every set instead of drawn (synth-data --rig-param): a study of rigs
+    /// that differ from the model in a way no candidate names, such as a strongly stiff string.
+    std::map<std::string, double> rig;
     bool keepSets = false;     ///< keep the generated WAV sets (regenerable from their seeds)
     bool generateOnly = false; ///< simulate and keep the sets, diagnose none (a later run diagnoses the kept sets)
     /// Run only these planned sets now (by index; empty = all) and only those hiding this effect
