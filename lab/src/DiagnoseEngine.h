@@ -53,6 +53,10 @@ StrokeFeatures features(std::vector<double> f, double fs, const Gesture& g, cons
 /// comparison is and away from the segment's ends: the rig's noise alone, any drift cancelled.
 /// Empty when the rest is too short (under about 3 ms).
 std::vector<double> restDifferences(std::vector<double> rest, double fs);
+/// The rig's noise as the white noise (rms, N) at rate fs that, low-passed and differenced as
+/// restDifferences() does, spreads as `differences` do: what the simulations must carry so
+/// that they and the recordings meet the comparison's low-pass with the same noise.
+double whiteNoiseOfRests(const std::vector<double>& differences, double fs);
 /// Six standard deviations of the fall that noise alone makes over 0.1 ms, from rest differences:
 /// at that lag (the low-pass's first correlation zero) their spread is sqrt(3) times the fall's.
 double slipFloorOf(std::vector<double> differences);
@@ -288,6 +292,8 @@ private:
 
 /// The floor of the test strokes (the final model against itself under the rig's scatter and
 /// noise) and what the final model leaves above it: which parts, where, and what it looks like.
+/// The residual against the usual one (DiagnoseOptions::usualResidualRatio), in words.
+std::string usualResidualText(const Residual& r);
 Residual measureResidual(const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& testSet,
                          const std::vector<ErrorParts>& currentTest, const std::vector<Prepared>& strokes, const DiagnoseOptions& o);
 

@@ -501,7 +501,10 @@ TEST(DiagnoseCalibration, AManifestsStatedPriorBoundsTheTensionAndBowPosition)
         return diag::fit(engine, EffectModel{}, cal, all, cal.start, o.maxEvaluations, 0.2);
     };
     const std::vector<double> free = calibrate(info);
-    EXPECT_NEAR(free[0], 1.03, 0.01) << "the default prior leaves room for the string's own tension";
+    // Within 1.5 %: the simulations carry the set's 10 mN noise as its rests show it (before
+    // 2026-11-29, each stroke's own estimate), which moved this 16-stroke fit from 1.03 to 1.04;
+    // a fit held at the manifest's 1.0 still fails by twice the tolerance.
+    EXPECT_NEAR(free[0], 1.03, 0.015) << "the default prior leaves room for the string's own tension";
     EXPECT_NEAR(free[1], 1.0, 0.01);
     diag::StringInfo known = info;
     known.tensionPrior = 0.01;
