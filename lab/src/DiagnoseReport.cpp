@@ -304,7 +304,8 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     if (d.findings.empty()) {
         const std::string why = d.residual.present
                                     ? "No effect on the list passed the naming rules, but the data are not explained: the test error " + fmt(d.finalError) +
-                                          " is " + fmt(d.residual.ratio, "%.1f") + " times the set's noise-and-chaos floor (see unexplained_residual)."
+                                          " is " + fmt(d.residual.ratio, "%.1f") + " times the set's noise-and-chaos floor (see unexplained_residual; " +
+                                          diag::usualResidualText(d.residual) + ")."
                                     : "No extension passed the naming rules, and the calibrated baseline's test error " + fmt(d.finalError) +
                                           " is within " + fmt(d.residual.ratio, "%.1f") + " times the set's noise-and-chaos floor: the baseline explains the data.";
         findings.push_back({{"effect", "none"}, {"evidence", why}, {"parameters", json::object()},
@@ -317,7 +318,8 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     json residual = nullptr;
     if (d.residual.present)
         residual = {{"error", d.residual.error}, {"floor", d.residual.floor}, {"ratio", d.residual.ratio}, {"parts", d.residual.parts},
-                    {"where", d.residual.where}, {"looks_like", d.residual.looksLike}};
+                    {"where", d.residual.where}, {"looks_like", d.residual.looksLike}, {"usual_ratio", d.residual.usual},
+                    {"beyond_usual", d.residual.beyondUsual}};
     json trials = json::array();
     for (const auto& t : d.trials)
         trials.push_back({{"round", t.round}, {"effect", t.effect}, {"parameters", t.parameters}, {"validation_fall", t.gain},
@@ -338,7 +340,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         {"calibration", calibration},
         {"rig_unknowns", rigUnknowns},
         {"unexplained_residual", residual},
-        {"floor", {{"error", d.residual.floor}, {"final_over_floor", d.residual.ratio}, {"final_parts", d.residual.partError},
+        {"floor", {{"error", d.residual.floor}, {"final_over_floor", d.residual.ratio}, {"usual_ratio", d.residual.usual}, {"final_parts", d.residual.partError},
                    {"floor_parts", d.residual.partFloor}}},
         {"rules", d.rules},
         {"trials", trials},
@@ -395,7 +397,8 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     if (d.residual.present) {
         md << "## Unexplained residual\n\nThe final model's test error is " << fmt(d.residual.ratio, "%.1f")
            << " times the floor: the data differ from every model on the list. It sits mostly at " << d.residual.where << ". It looks like this: "
-           << d.residual.looksLike << ".\n\n| part of the metric | mean excess over its floor (weighted) |\n|---|---|\n";
+           << d.residual.looksLike << ". How large: " << diag::usualResidualText(d.residual)
+           << ".\n\n| part of the metric | mean excess over its floor (weighted) |\n|---|---|\n";
         for (const auto& [part, v] : d.residual.parts) md << "| " << part << " | " << fmt(v) << " |\n";
         md << "\nNo label from the list is put on it.\n\n";
     }

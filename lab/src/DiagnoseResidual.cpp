@@ -12,6 +12,19 @@
 namespace rosin::lab::diag {
 
 
+std::string usualResidualText(const Residual& r)
+{
+    char buf[400];
+    if (r.usual <= 0.0) return "no usual residual was given to compare it with";
+    std::snprintf(buf, sizeof buf,
+                  "on the study's reference rigs with nothing hidden (strings, bridges and sensors that differ from the model's as a "
+                  "lab's usually do) the final error stayed within %.1f times the floor, so %.1f times is %s",
+                  r.usual, r.ratio,
+                  r.ratio > r.usual ? "more than the model's usual difference from a real string: something on this rig the model lacks"
+                                    : "within the model's usual difference from a real string, and says no more than that");
+    return buf;
+}
+
 Residual measureResidual(const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& testSet,
                          const std::vector<ErrorParts>& currentTest, const std::vector<Prepared>& strokes, const DiagnoseOptions& o)
 {
@@ -31,6 +44,8 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
         r.floor = std::max(mean(floorParts), 0.01);
         r.ratio = r.error / r.floor;
         r.present = r.ratio > o.residualFactor;
+        r.usual = o.usualResidualRatio;
+        r.beyondUsual = r.present && r.usual > 0.0 && r.ratio > r.usual;
         const char* names[] = {"first-slip time", "bridge force before the first slip", "first-slip jump", "transient length", "waveform after the first slip"};
         const auto& w = ErrorParts::kWeights;
         double partErr[5] = {0, 0, 0, 0, 0}, partFloor[5] = {0, 0, 0, 0, 0};

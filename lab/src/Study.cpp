@@ -76,6 +76,7 @@ struct Scored {
     std::map<std::string, double> rig;
     double baseline = 0, final = 0;
     bool unexplained = false;
+    bool beyondUsual = false;  ///< the residual is above the usual ratio the diagnosis compared it with
     double overFloor = 0;      ///< the final error over the set's noise-and-chaos floor
 };
 
@@ -314,6 +315,7 @@ std::string scoreStudy(const fs::path& dir)
         s.final = d["gain"]["final"].get<double>();
         s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
         if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
+        s.beyondUsual = s.unexplained && d["unexplained_residual"].value("beyond_usual", false);
         sets.push_back(std::move(s));
     }
     if (sets.empty()) throw LabError(dir.string() + ": no diagnosed sets to score");
@@ -335,17 +337,28 @@ std::string scoreStudy(const fs::path& dir)
     md << "Sets named exactly right (every hidden effect and nothing else): " << exact << " of " << sets.size() << ".\n";
     md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
     // What the models on the list could not explain, and how far above the sets' own floors.
-    int residuals = 0, nullResiduals = 0;
+    int residuals = 0, nullResiduals = 0, beyondUsual = 0;
     std::vector<double> overFloor;
     for (const auto& s : sets) {
         residuals += s.unexplained;
+        beyondUsual += s.beyondUsual;
         nullResiduals += s.unexplained && s.hidden.empty();
         overFloor.push_back(s.overFloor);
     }
     std::sort(overFloor.begin(), overFloor.end());
     md << "Unexplained residual reported on " << residuals << " of " << sets.size() << " sets (" << nullResiduals << " of the " << nNull
        << " null sets); final error over the set's floor: median " << fmt("%.2f", overFloor[overFloor.size() / 2])
-       << fmt(", from %.2f", overFloor.front()) << fmt(" to %.2f.\n", overFloor.back());
+       << fmt(", from %.2f", overFloor.front()) << fmt(" to %.2f", overFloor.back()) << "; more than the usual residual on " << beyondUsual
+       << " of " << sets.size() << ".\n";
+    // The usual residual: what the model leaves where nothing is hidden, on this rig population.
+    double usual = 0;
+    for (const auto& s : sets)
+        if (s.hidden.empty()) usual = std::max(usual, s.overFloor);
+    if (nNull > 0 && usual > 0) {
+        md << fmt("The null sets' largest final error over floor, %.1f, is this rig population's usual residual (`rosin diagnose ", usual)
+           << fmt("--usual-residual %.1f` takes it).\n", usual);
+        summary["usual_residual_measured"] = usual;
+    }
     json plan;
     if (fs::exists(dir / "plan.json")) std::ifstream(dir / "plan.json") >> plan;
     if (plan.contains("rig")) {
@@ -355,7 +368,8 @@ std::string scoreStudy(const fs::path& dir)
         summary["fixed_rig"] = plan["rig"];
     }
     md << "\n";
-    summary["unexplained_residual"] = {{"sets", residuals}, {"null_sets", nullResiduals}, {"median_over_floor", overFloor[overFloor.size() / 2]}};
+    summary["unexplained_residual"] = {
+        {"sets", residuals}, {"null_sets", nullResiduals}, {"beyond_usual", beyondUsual}, {"median_over_floor", overFloor[overFloor.size() / 2]}};
     summary["sets"] = sets.size();
     summary["exact"] = exact;
     summary["null_sets"] = nNull;
@@ -529,11 +543,12 @@ std::string scoreStudy(const fs::path& dir)
         for (const auto& [p, v] : s.estimate) found += " " + p + fmt("=%.3g", v[0]);
         std::string hidden = joined(s.hidden);
         for (const auto& [p, v] : s.truth) hidden += " " + p + fmt("=%.3g", v);
-        md << "| " << s.index << " | " << hidden << " | " << found << (s.unexplained ? " (+ unexplained residual)" : "") << " | "
+        md << "| " << s.index << " | " << hidden << " | " << found
+           << (s.unexplained ? (s.beyondUsual ? " (+ unexplained residual, more than usual)" : " (+ unexplained residual)") : "") << " | "
            << fmt("%.3f", s.baseline) << fmt(" -> %.3f", s.final) << " |\n";
         perSet.push_back({{"set", s.index}, {"seed", s.seed}, {"hidden", s.hidden}, {"found", s.found}, {"truth", s.truth},
                           {"baseline_error", s.baseline}, {"final_error", s.final}, {"unexplained", s.unexplained},
-                          {"over_floor", s.overFloor}});
+                          {"beyond_usual", s.beyondUsual}, {"over_floor", s.overFloor}});
     }
     std::ofstream(dir / "study.json") << json{{"summary", summary}, {"sets", perSet}}.dump(1) << "\n";
     std::ofstream(dir / "summary.md") << md.str();

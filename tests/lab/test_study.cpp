@@ -354,8 +354,8 @@ TEST(Study, CountsTheUnexplainedResidualsAndHowFarAboveTheirFloorsTheSetsAre)
 {
     const fs::path dir = freshDir("residual");
     const auto withFloor = [](json d, double overFloor, bool unexplained) {
-        d["floor"] = {{"final_over_floor", overFloor}};
-        if (unexplained) d["unexplained_residual"] = {{"ratio", overFloor}};
+        d["floor"] = {{"final_over_floor", overFloor}, {"usual_ratio", 8.0}};
+        if (unexplained) d["unexplained_residual"] = {{"ratio", overFloor}, {"usual_ratio", 8.0}, {"beyond_usual", overFloor > 8.0}};
         return d;
     };
     const json none = diagnosis(json::array({{{"effect", "none"}}}));
@@ -363,18 +363,28 @@ TEST(Study, CountsTheUnexplainedResidualsAndHowFarAboveTheirFloorsTheSetsAre)
     writeSet(dir, 1, {{"effects", json::array()}, {"params", json::object()}}, withFloor(none, 9.0, true));
     writeSet(dir, 2, {{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.2}}}},
              withFloor(thermalDiagnosis(1.18, 1.1, 1.3, json::object()), 4.0, true));
+    // A diagnosis.json from before the comparison with the usual residual counts as not beyond it.
+    json older = withFloor(thermalDiagnosis(1.18, 1.1, 1.3, json::object()), 20.0, true);
+    older["unexplained_residual"].erase("beyond_usual");
+    writeSet(dir, 3, {{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.2}}}}, older);
     std::ofstream(dir / "plan.json") << json{{"rig", {{"inharmonicity", 1e-3}}}}.dump();
     const std::string md = scoreStudy(dir);
     json study;
     std::ifstream(dir / "study.json") >> study;
     const json& r = study["summary"]["unexplained_residual"];
-    EXPECT_EQ(r["sets"], 2);
+    EXPECT_EQ(r["sets"], 3);
     EXPECT_EQ(r["null_sets"], 1);
-    EXPECT_DOUBLE_EQ(r["median_over_floor"].get<double>(), 4.0);
-    EXPECT_NE(md.find("Unexplained residual reported on 2 of 3 sets (1 of the 2 null sets); final error over the set's floor: median 4.00, "
-                      "from 1.50 to 9.00."),
+    EXPECT_EQ(r["beyond_usual"], 1); // set 1: 9 over a usual 8
+    EXPECT_DOUBLE_EQ(r["median_over_floor"].get<double>(), 9.0);
+    EXPECT_NE(md.find("Unexplained residual reported on 3 of 4 sets (1 of the 2 null sets); final error over the set's floor: median 9.00, "
+                      "from 1.50 to 20.00; more than the usual residual on 1 of 4."),
               std::string::npos)
         << md;
+    // The usual residual this study measures: the largest ratio where nothing was hidden.
+    EXPECT_DOUBLE_EQ(study["summary"]["usual_residual_measured"].get<double>(), 9.0);
+    EXPECT_NE(md.find("`rosin diagnose --usual-residual 9.0` takes it"), std::string::npos) << md;
+    EXPECT_TRUE(study["sets"][1]["beyond_usual"].get<bool>());
+    EXPECT_FALSE(study["sets"][3]["beyond_usual"].get<bool>());
     EXPECT_NE(md.find("Rig values fixed in every set instead of drawn: inharmonicity = 0.001."), std::string::npos) << md;
     EXPECT_DOUBLE_EQ(study["sets"][1]["over_floor"].get<double>(), 9.0);
     fs::remove_all(dir);

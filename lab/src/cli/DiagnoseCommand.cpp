@@ -58,6 +58,11 @@ struct DiagnoseCommand {
         diagnoseCmd->add_option("--max-evaluations", diagOptions.maxEvaluations, "Model evaluations per candidate fit")->check(CLI::Range(5, 500))->capture_default_str();
         diagnoseCmd->add_option("--naming-threshold", diagOptions.namingThreshold, "Least validation-error fall (share) of a named effect")->check(finiteIn(0, 1))->capture_default_str();
         diagnoseCmd->add_option("--residual-factor", diagOptions.residualFactor, "Final error above this many floors: unexplained residual")->check(finiteIn(1, 100))->capture_default_str();
+        diagnoseCmd->add_option("--usual-residual", diagOptions.usualResidualRatio,
+                                "Final error over floor that the model leaves on the study's reference rigs with nothing hidden: a residual "
+                                "above it is reported as more than the usual difference (0 = no comparison)")
+            ->check(finiteIn(0, 1000))
+            ->capture_default_str();
         diagnoseCmd->add_option("--model-discrepancy", discrepancy,
                                 "NAME=SD: the model's own error for parameter NAME (r_A and zt_ratio relative, others absolute; 0 = none), "
                                 "instead of the study-calibrated default (" + defaultDiscrepancyText() + ")");

@@ -65,6 +65,11 @@ struct DiagnoseOptions {
     /// sets of `rosin study` so that at most 5 % of them name anything (docs/diagnosis.md).
     double namingThreshold = 0.05;
     double residualFactor = 3.0;    ///< final error above this many times the floor: unexplained residual
+    /// Final error over floor that the waveguide leaves on reference rigs with nothing hidden
+    /// (their strings, bridges and sensors differ from the model's as a lab's usually do): a
+    /// residual above it is more than that usual difference. Measured by `rosin study` (seed 2047:
+    /// docs/diagnosis-study.md); 0 = no comparison.
+    double usualResidualRatio = 8.6;
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     /// The model's own error on rigs it does not describe (their thermal constants, an unnamed
     /// torsion): the standard deviation that a finding's parameter still misses the truth by
@@ -145,6 +150,8 @@ struct Residual {
     std::map<std::string, double> partError, partFloor; ///< every part's weighted mean: final error and floor
     std::string where;                      ///< the region of the Guettler plane that carries most of it
     std::string looksLike;                  ///< its signature in plain words
+    double usual = 0;                       ///< the usual ratio it was compared with (0: none)
+    bool beyondUsual = false;               ///< present, and above the usual ratio
 };
 
 /// A two-ended steady stroke: measured and final-model (v, f) loops by Schumacher's method.
