@@ -123,8 +123,10 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
             std::snprintf(buf, sizeof buf, "the first slip comes at a nearly fixed bow speed whatever the force (bow speed at slip ~ F^%.2f; a static-friction law gives about F^0.5)", slope);
             look = buf;
         } else if (r.parts.count("waveform after the first slip") || r.parts.count("transient length")) {
-            look = "the waveform and transients after the first slip disagree more than chaos allows while the first slip agrees: a period "
-                   "or waveform mismatch such as string stiffness or a compliant bridge gives";
+            look = std::string("the waveform and transients after the first slip disagree more than chaos allows") +
+                   (r.parts.count("first-slip jump") ? ", and so does the first slip's jump," : "") +
+                   (r.parts.count("first-slip time") ? "" : " while the first slip comes when the model's does") +
+                   ": a period or waveform mismatch such as string stiffness or a compliant bridge gives";
         } else {
             std::snprintf(buf, sizeof buf, "the model's first slips come %.1f %% %s and its pre-slip bridge force is %.1f %% of the bow force %s on average",
                           100 * std::abs(slipBias), slipBias > 0 ? "late" : "early", 100 * std::abs(forceBias), forceBias > 0 ? "high" : "low");
