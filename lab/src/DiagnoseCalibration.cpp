@@ -310,8 +310,8 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
                                  spread ? single[single.size() - 1 - single.size() / 40] : *slipFloor});
         // The noise the simulations carry comes from the rests too. Read from the stroke itself,
         // the steps of a bowed string's own waveform (its corners, a stiff string's ringing) count
-        // as noise: up to 30 times the rig's on a quiet rig, which blurs the simulations and lifts
-        // the floor the residual is judged against.
+        // as noise: 100 times the rig's on a quiet rig (250 with a far stiffer string), which blurs
+        // the simulations and lifts the floor the residual is judged against.
         const double white = whiteNoiseOfRests(pooled, o.simRate);
         for (Prepared& p : strokes) p.noise = white;
         d.calibration.push_back({"noise_n", "the rig's noise as white noise at the simulation rate (rms), from the rests before the gestures; "

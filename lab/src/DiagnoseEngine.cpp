@@ -46,8 +46,8 @@ std::vector<double> restDifferences(std::vector<double> rest, double fs)
 
 double whiteNoiseOfRests(const std::vector<double>& differences, double fs)
 {
-    // A unit white noise through the same path gives the factor (about 0.6 at 48 kHz: the
-    // low-pass keeps 5 of 24 kHz, the differences multiply by up to 2).
+    // The factor from the rests' spread to the white noise's level depends on the low-pass and
+    // the lag at this rate: a unit white noise sent through the same path measures it.
     std::vector<double> unit(static_cast<std::size_t>(std::lround(0.5 * fs)));
     std::mt19937_64 rng(0x5eed);
     std::normal_distribution<double> g(0.0, 1.0);
