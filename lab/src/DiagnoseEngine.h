@@ -290,10 +290,10 @@ private:
     mutable tbb::enumerable_thread_specific<Voice> voices_;
 };
 
-/// The floor of the test strokes (the final model against itself under the rig's scatter and
-/// noise) and what the final model leaves above it: which parts, where, and what it looks like.
 /// The residual against the usual one (DiagnoseOptions::usualResidualRatio), in words.
 std::string usualResidualText(const Residual& r);
+/// The floor of the test strokes (the final model against itself under the rig's scatter and
+/// noise) and what the final model leaves above it: which parts, where, and what it looks like.
 Residual measureResidual(const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& testSet,
                          const std::vector<ErrorParts>& currentTest, const std::vector<Prepared>& strokes, const DiagnoseOptions& o);
 
