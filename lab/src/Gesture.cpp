@@ -86,14 +86,10 @@ std::vector<GestureRow> loadGestureFile(const std::filesystem::path& file)
         for (std::size_t k = 0; k < names.size(); ++k) {
             if (column[k] >= static_cast<int>(cells.size())) fail("field '" + names[k] + "' is missing");
             const std::string& cell = cells[column[k]];
-            std::size_t used = 0;
-            try {
-                v[k] = std::stod(cell, &used);
-            } catch (const std::exception&) {
-                used = 0;
-            }
-            if (used == 0 || used != cell.size() || !std::isfinite(v[k]))
+            const std::optional<double> number = wholeNumber(cell);
+            if (!number || !std::isfinite(*number))
                 fail("field '" + names[k] + "' is not a finite number: '" + cell + "'");
+            v[k] = *number;
         }
         GestureRow r{v[0], v[1], v[2], v[3]};
         if (r.time < 0) fail("field 'time' must not be negative");

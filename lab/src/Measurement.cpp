@@ -132,12 +132,7 @@ std::vector<double> readCsvForce(const fs::path& file, double manifestRate)
         const auto comma = line.find(',');
         if (comma == std::string::npos) throw LabError(file.string() + ":" + std::to_string(lineNo) + ": field 'force' is missing");
         auto number = [&](const std::string& s, const char* field) {
-            try {
-                std::size_t used = 0;
-                const double v = std::stod(s, &used);
-                if (used == s.size() && std::isfinite(v)) return v;
-            } catch (const std::exception&) {
-            }
+            if (const std::optional<double> v = wholeNumber(s); v && std::isfinite(*v)) return *v;
             throw LabError(file.string() + ":" + std::to_string(lineNo) + ": field '" + field + "' is not a finite number");
         };
         t.push_back(number(line.substr(0, comma), "time_s"));

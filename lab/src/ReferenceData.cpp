@@ -113,16 +113,10 @@ std::map<std::string, double> parseRigValues(const std::vector<std::string>& nam
     for (const auto& kv : nameEqualsValue) {
         const auto eq = kv.find('=');
         if (eq == std::string::npos) throw LabError("--rig-param: expected NAME=VALUE, got '" + kv + "'");
-        double value = 0.0;
-        try {
-            std::size_t used = 0;
-            value = std::stod(kv.substr(eq + 1), &used);
-            if (used != kv.size() - eq - 1) throw std::invalid_argument("trailing text");
-        } catch (const std::exception&) {
-            throw LabError("--rig-param: '" + kv + "' has no number");
-        }
-        checkRigValue(kv.substr(0, eq), value);
-        rig[kv.substr(0, eq)] = value;
+        const std::optional<double> value = wholeNumber(kv.substr(eq + 1));
+        if (!value) throw LabError("--rig-param: '" + kv + "' has no number");
+        checkRigValue(kv.substr(0, eq), *value);
+        rig[kv.substr(0, eq)] = *value;
     }
     return rig;
 }

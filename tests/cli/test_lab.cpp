@@ -274,6 +274,8 @@ TEST(RosinCli, BadArgumentsFailClearlyAndWriteNothing)
         {"diagnose some-set --model-discrepancy r_A=-0.1" + out, "--model-discrepancy r_A=-0.1"},
         {"diagnose some-set --model-discrepancy colour=0.1" + out, "--model-discrepancy colour=0.1"},
         {"diagnose some-set --model-discrepancy p" + out, "--model-discrepancy p"},
+        {"diagnose some-set --model-discrepancy p=0.1x" + out, "--model-discrepancy p=0.1x"}, // trailing text, once read as 0.1
+        {"render --set tension_n=60N" + out, "--set tension_n: '60N' is not a number"},
     };
     for (const auto& [args, expected] : cases) {
         const CliRun r = runRosin(args);

@@ -384,6 +384,11 @@ TEST(SynthDataCli, WritesASetAndItsTruthApartAndRefusesToOverwrite)
     EXPECT_NE(badParam.second.find("--param"), std::string::npos) << badParam.second;
     EXPECT_FALSE(fs::exists(d / "other"));
     EXPECT_FALSE(fs::exists(d / "other.truth.json"));
+    // a number with trailing text is no number (it was once read as its leading 1.2)
+    const auto trailing = run(cli + " synth-data --param r_A=1.2x -q -o " + (d / "other").string());
+    EXPECT_NE(trailing.first, 0);
+    EXPECT_NE(trailing.second.find("--param: 'r_A=1.2x' has no number"), std::string::npos) << trailing.second;
+    EXPECT_FALSE(fs::exists(d / "other"));
     fs::remove_all(d);
 }
 

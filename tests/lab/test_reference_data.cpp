@@ -116,6 +116,19 @@ TEST(ReferenceSynthData, RigValuesFromTheCommandLineAreParsedOrRefusedByName)
     EXPECT_NE(refusal({"bridge_z0y="}).find("has no number"), std::string::npos);
 }
 
+// The one reading of "is this text a number" behind every command-line value and data field.
+TEST(ReferenceSynthData, AWholeNumberIsAllOfTheTextAndNothingMore)
+{
+    EXPECT_EQ(wholeNumber("1e-3"), 1e-3);
+    EXPECT_EQ(wholeNumber("-0.25"), -0.25);
+    EXPECT_EQ(wholeNumber(" 4"), 4.0); // leading blanks, as std::stod reads them
+    for (const char* no : {"", "abc", "1.2x", "1.2 ", "0x", "1e", "--1"}) EXPECT_FALSE(wholeNumber(no).has_value()) << "'" << no << "'";
+    // NaN and infinity parse: each caller refuses them in its own words
+    ASSERT_TRUE(wholeNumber("nan").has_value());
+    EXPECT_TRUE(std::isnan(*wholeNumber("nan")));
+    EXPECT_TRUE(std::isinf(*wholeNumber("inf")));
+}
+
 TEST(ReferenceSynthData, BrokenSteadySlidingFileIsNamedWithItsLine)
 {
     SynthTruth truth;

@@ -23,14 +23,9 @@ inline CLI::Validator finiteIn(double lo, double hi)
 {
     return CLI::Validator(
         [lo, hi](std::string& s) -> std::string {
-            double x = 0.0;
-            try {
-                std::size_t used = 0;
-                x = std::stod(s, &used);
-                if (used != s.size()) return "'" + s + "' is not a number";
-            } catch (const std::exception&) {
-                return "'" + s + "' is not a number";
-            }
+            const std::optional<double> number = wholeNumber(s);
+            if (!number) return "'" + s + "' is not a number";
+            const double x = *number;
             if (!std::isfinite(x) || x < lo || x > hi)
                 return "value " + s + " is outside " + std::to_string(lo) + ".." + std::to_string(hi);
             return {};
@@ -131,14 +126,9 @@ struct ModelOptions {
             const std::string name = kv.substr(0, eq);
             const auto it = fields.find(name);
             if (eq == std::string::npos || it == fields.end()) throw LabError("--set: unknown parameter '" + name + "'");
-            double v = 0;
-            try {
-                std::size_t used = 0;
-                v = std::stod(kv.substr(eq + 1), &used);
-                if (used != kv.size() - eq - 1) throw std::invalid_argument("trailing");
-            } catch (const std::exception&) {
-                throw LabError("--set " + name + ": '" + kv.substr(eq + 1) + "' is not a number");
-            }
+            const std::optional<double> number = wholeNumber(kv.substr(eq + 1));
+            if (!number) throw LabError("--set " + name + ": '" + kv.substr(eq + 1) + "' is not a number");
+            const double v = *number;
             if (!std::isfinite(v) || v < 0 || (v == 0 && name != "inharmonicity")) throw LabError("--set " + name + ": must be a positive number");
             *it->second = v;
             keepPitch |= name == "tension_n" || name == "length_m";

@@ -76,11 +76,7 @@ struct DiagnoseCommand {
         for (const std::string& item : discrepancy) {
             const auto eq = item.find('=');
             const std::string name = item.substr(0, eq);
-            double sd = std::nan("");
-            try {
-                if (eq != std::string::npos) sd = std::stod(item.substr(eq + 1));
-            } catch (const std::exception&) {
-            }
+            const double sd = eq != std::string::npos ? wholeNumber(item.substr(eq + 1)).value_or(std::nan("")) : std::nan("");
             if (effectOfParameter(name) == "calibration" || !std::isfinite(sd) || sd < 0.0 || sd > 10.0) // not a finding's parameter
                 throw LabError("--model-discrepancy " + item + ": expected NAME=SD with NAME one of r_A, h0, p, load_exponent, shift_k, zt_ratio and SD from 0 to 10");
             diagOptions.modelDiscrepancy[name] = sd;

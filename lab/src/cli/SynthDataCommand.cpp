@@ -84,11 +84,9 @@ struct SynthDataCommand {
             const std::string key = kv.substr(0, eq);
             if (key != "r_A" && key != "load_exponent" && key != "shift_k" && key != "zt_ratio" && key != "h0" && key != "p")
                 throw LabError("--param: unknown parameter '" + key + "'");
-            try {
-                synth.params[key] = std::stod(kv.substr(eq + 1));
-            } catch (const std::exception&) {
-                throw LabError("--param: '" + kv + "' has no number");
-            }
+            const std::optional<double> value = wholeNumber(kv.substr(eq + 1));
+            if (!value) throw LabError("--param: '" + kv + "' has no number");
+            synth.params[key] = *value;
         }
         synth.rig = parseRigValues(rigParams);
         if (fs::exists(synthOut)) throw LabError(synthOut + ": already exists (choose a new folder)");
