@@ -172,6 +172,14 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                "After each new finding every earlier one must still earn its place: the model is refitted without it, and an effect whose "
                "absence raises the validation error by less than the naming threshold is dropped and not tried again.",
                "The reported gain compares the calibrated baseline and the final model on the test strokes only."};
+    if (o.usualResidualRatio > 0.0) {
+        char usual[32];
+        std::snprintf(usual, sizeof usual, "%.3g", o.usualResidualRatio);
+        d.rules.push_back("(6) When the final model leaves a residual beyond the usual one (more than " + std::string(usual) +
+                          " times the set's floor), the model lacks something on this rig, and a rate dependence, a rosin shift, a contact "
+                          "law or a rolling string can bend the friction to stand in for it: only thermal memory stays named, and the others "
+                          "are reported as possible stand-ins with their parameters, not as findings.");
+    }
 
     // 4. From the calibrated baseline, add effects one round at a time.
     int round = 0;
@@ -509,6 +517,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     // 5. The set's own floor, and what the final model leaves above it.
     say("noise and chaos floor", 0.0);
     d.residual = measureResidual(engine, current, testSet, currentTest, strokes, o);
+    setAsideStandIns(d);
 
     // 4. What the report shows: every stroke under the baseline and the final model.
     say("report", 0.0);

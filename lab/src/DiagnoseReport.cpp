@@ -274,13 +274,21 @@ std::pair<double, double> reportedInterval(const Finding& f, const std::string& 
     return {std::max(bottom, lo), std::min(top, hi)};
 }
 
+namespace {
+std::string effectList(const std::vector<Finding>& list)
+{
+    std::string out;
+    for (std::size_t k = 0; k < list.size(); ++k) out += (k == 0 ? "" : k + 1 == list.size() ? " and " : ", ") + list[k].effect;
+    return out;
+}
+} // namespace
+
 void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptions& o)
 {
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (!fs::is_directory(dir)) throw LabError(dir.string() + ": cannot create the output directory");
-    json findings = json::array();
-    for (const auto& f : d.findings) {
+    auto findingJson = [](const Finding& f) {
         json params = json::object();
         for (const auto& [name, v] : f.parameters) {
             const auto [lo, hi] = reportedInterval(f, name);
@@ -298,11 +306,17 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
                 params[name]["rolling_softening"] = {{"value", s}, {"ci95", {low, high}}};
             }
         }
-        findings.push_back({{"effect", f.effect}, {"evidence", f.evidence}, {"parameters", params},
-                            {"heldout_error_before", f.heldoutBefore}, {"heldout_error_after", f.heldoutAfter}});
-    }
+        return json{{"effect", f.effect}, {"evidence", f.evidence}, {"parameters", params},
+                    {"heldout_error_before", f.heldoutBefore}, {"heldout_error_after", f.heldoutAfter}};
+    };
+    json findings = json::array(), standIns = json::array();
+    for (const auto& f : d.findings) findings.push_back(findingJson(f));
+    for (const auto& f : d.standIns) standIns.push_back(findingJson(f));
     if (d.findings.empty()) {
-        const std::string why = d.residual.present
+        const std::string why = !d.standIns.empty()
+                                    ? "The rounds named " + effectList(d.standIns) + ", but the residual the final model leaves is beyond the usual one (" +
+                                          fmt(d.residual.ratio, "%.1f") + " times the floor), so they are reported as possible stand-ins (stand_ins), not named."
+                                : d.residual.present
                                     ? "No effect on the list passed the naming rules, but the data are not explained: the test error " + fmt(d.finalError) +
                                           " is " + fmt(d.residual.ratio, "%.1f") + " times the set's noise-and-chaos floor (see unexplained_residual; " +
                                           diag::usualResidualText(d.residual) + ")."
@@ -319,7 +333,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     if (d.residual.present)
         residual = {{"error", d.residual.error}, {"floor", d.residual.floor}, {"ratio", d.residual.ratio}, {"parts", d.residual.parts},
                     {"where", d.residual.where}, {"looks_like", d.residual.looksLike}, {"usual_ratio", d.residual.usual},
-                    {"beyond_usual", d.residual.beyondUsual}};
+                    {"beyond_usual", d.residual.beyondUsual}, {"stand_ins", standIns}};
     json trials = json::array();
     for (const auto& t : d.trials)
         trials.push_back({{"round", t.round}, {"effect", t.effect}, {"parameters", t.parameters}, {"validation_fall", t.gain},
@@ -401,9 +415,24 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
            << ".\n\n| part of the metric | mean excess over its floor (weighted) |\n|---|---|\n";
         for (const auto& [part, v] : d.residual.parts) md << "| " << part << " | " << fmt(v) << " |\n";
         md << "\nNo label from the list is put on it.\n\n";
+        if (!d.standIns.empty()) {
+            md << "### Possible stand-ins (not named)\n\nThe rounds named " << effectList(d.standIns) << " under rules 1-5, and the final model's "
+               << "error and the residual above are measured with " << (d.standIns.size() > 1 ? "them" : "it") << " in. But with a residual "
+               << "beyond the usual one the model lacks something here, and a further bend of the friction law, the contact or a rolling "
+               << "string can take the place of what it lacks (on strings ten times stiffer than the studies' stiffest, a +25 K rosin "
+               << "shift was fitted in place of a hidden rate law). So " << (d.standIns.size() > 1 ? "they are" : "it is")
+               << " not named (rule 6): what would be named, and where the fits put it:\n\n| effect | parameter | value | 95 % CI (reported) |\n|---|---|---|---|\n";
+            for (const auto& f : d.standIns)
+                for (const auto& [name, v] : f.parameters) {
+                    const auto [lo, hi] = reportedInterval(f, name);
+                    md << "| " << f.effect << " | " << name << " | " << fmt(v[0]) << " | " << fmt(lo) << " – " << fmt(hi) << " |\n";
+                }
+            md << "\n";
+        }
     }
     md << "## Findings\n\n";
-    if (d.findings.empty()) md << (d.residual.present ? "None named (see the unexplained residual).\n\n" : "None: the calibrated baseline explains the data within its floor.\n\n");
+    if (d.findings.empty() && !d.standIns.empty()) md << "None named: the effects the rounds found are possible stand-ins beside an unusual residual (above).\n\n";
+    else if (d.findings.empty()) md << (d.residual.present ? "None named (see the unexplained residual).\n\n" : "None: the calibrated baseline explains the data within its floor.\n\n");
     for (const auto& f : d.findings) {
         md << "### " << f.effect << "\n\n" << f.evidence
            << "\n\n| parameter | value | 95 % CI (reported) | bootstrap refits | curvature | low / high drive half | rig unknowns (down / up) | model discrepancy (+-) |\n|---|---|---|---|---|---|---|---|\n";

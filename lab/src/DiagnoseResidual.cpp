@@ -123,9 +123,10 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
             std::snprintf(buf, sizeof buf, "the first slip comes at a nearly fixed bow speed whatever the force (bow speed at slip ~ F^%.2f; a static-friction law gives about F^0.5)", slope);
             look = buf;
         } else if (r.parts.count("waveform after the first slip") || r.parts.count("transient length")) {
+            const bool jump = r.parts.count("first-slip jump") > 0;
             look = std::string("the waveform and transients after the first slip disagree more than chaos allows") +
-                   (r.parts.count("first-slip jump") ? ", and so does the first slip's jump," : "") +
-                   (r.parts.count("first-slip time") ? "" : " while the first slip comes when the model's does") +
+                   (jump ? ", and so does the first slip's jump" : "") +
+                   (r.parts.count("first-slip time") ? "" : (jump ? ", while" : " while") + std::string(" the first slip comes when the model's does")) +
                    ": a period or waveform mismatch such as string stiffness or a compliant bridge gives";
         } else {
             std::snprintf(buf, sizeof buf, "the model's first slips come %.1f %% %s and its pre-slip bridge force is %.1f %% of the bow force %s on average",
@@ -134,6 +135,25 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
         }
         r.looksLike = look;
         return r;
+}
+
+std::size_t setAsideStandIns(Diagnosis& d)
+{
+    if (!d.residual.beyondUsual) return 0;
+    // Thermal memory stays: no rig in the studies has imitated it (never named where not hidden
+    // on seeds 2044-2047, far stiffer strings or a far more compliant bridge), and its first-slip
+    // jumps move by tens of per cent of the bow force where a missing stiffness moves them by a
+    // few. The others bend the law it gives; on strings ten times stiffer than the prior's, a
+    // +25 K shift was named in place of a hidden rate law beside a residual of 8.8 floors.
+    const auto standIn = [](const Finding& f) { return f.effect != "thermal_memory"; };
+    std::size_t moved = 0;
+    for (const Finding& f : d.findings)
+        if (standIn(f)) {
+            d.standIns.push_back(f);
+            ++moved;
+        }
+    d.findings.erase(std::remove_if(d.findings.begin(), d.findings.end(), standIn), d.findings.end());
+    return moved;
 }
 
 } // namespace rosin::lab::diag

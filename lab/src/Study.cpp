@@ -77,6 +77,7 @@ struct Scored {
     double baseline = 0, final = 0;
     bool unexplained = false;
     bool beyondUsual = false;  ///< the residual is above the usual ratio the diagnosis compared it with
+    std::vector<std::string> standIns; ///< effects set aside beside a residual beyond the usual one (rule 6): not named
     double overFloor = 0;      ///< the final error over the set's noise-and-chaos floor
 };
 
@@ -316,6 +317,8 @@ std::string scoreStudy(const fs::path& dir)
         s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
         if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
         s.beyondUsual = s.unexplained && d["unexplained_residual"].value("beyond_usual", false);
+        if (s.unexplained && d["unexplained_residual"].contains("stand_ins"))
+            for (const auto& standIn : d["unexplained_residual"]["stand_ins"]) s.standIns.push_back(standIn["effect"].get<std::string>());
         sets.push_back(std::move(s));
     }
     if (sets.empty()) throw LabError(dir.string() + ": no diagnosed sets to score");
@@ -359,8 +362,27 @@ std::string scoreStudy(const fs::path& dir)
            << fmt("--usual-residual %.1f` takes it).\n", usual);
         summary["usual_residual_measured"] = usual;
     }
+    // Stand-ins: what rule 6 kept from being named, and whether the set hid it (a miss) or not
+    // (a wrong label it kept out).
+    int standInSets = 0, standInsHidden = 0, standInsNotHidden = 0;
+    for (const auto& s : sets) {
+        standInSets += !s.standIns.empty();
+        for (const auto& e : s.standIns) {
+            if (std::find(s.hidden.begin(), s.hidden.end(), e) != s.hidden.end()) ++standInsHidden;
+            else ++standInsNotHidden;
+        }
+    }
+    if (standInSets > 0)
+        md << "Possible stand-ins set aside beside a residual beyond the usual one (rule 6), not named: on " << standInSets << " of " << sets.size()
+           << " sets; " << standInsNotHidden << " of them not hidden in their set (a wrong label kept out), " << standInsHidden << " hidden (a miss).\n";
     json plan;
-    if (fs::exists(dir / "plan.json")) std::ifstream(dir / "plan.json") >> plan;
+    if (fs::exists(dir / "plan.json")) {
+        try {
+            std::ifstream(dir / "plan.json") >> plan;
+        } catch (const json::exception& e) {
+            throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
+        }
+    }
     if (plan.contains("rig")) {
         std::string fixed;
         for (const auto& [k, v] : plan["rig"].items()) fixed += (fixed.empty() ? "" : ", ") + k + fmt(" = %.3g", v.get<double>());
@@ -370,6 +392,7 @@ std::string scoreStudy(const fs::path& dir)
     md << "\n";
     summary["unexplained_residual"] = {
         {"sets", residuals}, {"null_sets", nullResiduals}, {"beyond_usual", beyondUsual}, {"median_over_floor", overFloor[overFloor.size() / 2]}};
+    summary["stand_ins"] = {{"sets", standInSets}, {"not_hidden", standInsNotHidden}, {"hidden", standInsHidden}};
     summary["sets"] = sets.size();
     summary["exact"] = exact;
     summary["null_sets"] = nNull;
@@ -544,11 +567,12 @@ std::string scoreStudy(const fs::path& dir)
         std::string hidden = joined(s.hidden);
         for (const auto& [p, v] : s.truth) hidden += " " + p + fmt("=%.3g", v);
         md << "| " << s.index << " | " << hidden << " | " << found
-           << (s.unexplained ? (s.beyondUsual ? " (+ unexplained residual, more than usual)" : " (+ unexplained residual)") : "") << " | "
+           << (s.unexplained ? (s.beyondUsual ? " (+ unexplained residual, more than usual)" : " (+ unexplained residual)") : "")
+           << (s.standIns.empty() ? "" : " (possible stand-in, not named: " + joined(s.standIns) + ")") << " | "
            << fmt("%.3f", s.baseline) << fmt(" -> %.3f", s.final) << " |\n";
         perSet.push_back({{"set", s.index}, {"seed", s.seed}, {"hidden", s.hidden}, {"found", s.found}, {"truth", s.truth},
                           {"baseline_error", s.baseline}, {"final_error", s.final}, {"unexplained", s.unexplained},
-                          {"beyond_usual", s.beyondUsual}, {"over_floor", s.overFloor}});
+                          {"beyond_usual", s.beyondUsual}, {"stand_ins", s.standIns}, {"over_floor", s.overFloor}});
     }
     std::ofstream(dir / "study.json") << json{{"summary", summary}, {"sets", perSet}}.dump(1) << "\n";
     std::ofstream(dir / "summary.md") << md.str();

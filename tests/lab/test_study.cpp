@@ -390,6 +390,60 @@ TEST(Study, CountsTheUnexplainedResidualsAndHowFarAboveTheirFloorsTheSetsAre)
     fs::remove_all(dir);
 }
 
+// Rule 6's stand-ins are not named: they count neither as detections nor as false positives, and
+// the summary says on how many sets they were set aside and whether each was hidden there (a miss)
+// or not (a wrong label kept out).
+TEST(Study, CountsTheStandInsSetAsideBesideAnUnusualResidualAndDoesNotScoreThemAsNamed)
+{
+    const fs::path dir = freshDir("standins");
+    const auto beyond = [](json d, const json& standIns) {
+        d["floor"] = {{"final_over_floor", 9.5}, {"usual_ratio", 8.6}};
+        d["unexplained_residual"] = {{"ratio", 9.5}, {"usual_ratio", 8.6}, {"beyond_usual", true}, {"stand_ins", standIns}};
+        return d;
+    };
+    // set 0 hides a rate law; the rounds fitted a shift in its place, set aside
+    writeSet(dir, 0, {{"effects", {"thermal_memory", "rate_dependence"}}, {"params", {{"r_A", 1.08}, {"p", 0.54}}}},
+             beyond(thermalDiagnosis(1.2, 1.0, 1.4, json::object()), json::array({finding("rosin_temperature_shift", "shift_k", 25.0, 5.0, 30.0)})));
+    // set 1 hides a contact, and the contact it found is set aside too
+    writeSet(dir, 1, {{"effects", {"thermal_memory", "hertzian_contact"}}, {"params", {{"r_A", 1.0}, {"load_exponent", 0.7}}}},
+             beyond(thermalDiagnosis(1.02, 0.9, 1.1, json::object()), json::array({finding("hertzian_contact", "load_exponent", 0.72, 0.6, 0.8)})));
+    writeSet(dir, 2, {{"effects", json::array()}, {"params", json::object()}}, beyond(diagnosis(json::array({{{"effect", "none"}}})), json::array()));
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    const json& st = study["summary"]["stand_ins"];
+    EXPECT_EQ(st["sets"], 2);
+    EXPECT_EQ(st["not_hidden"], 1);
+    EXPECT_EQ(st["hidden"], 1);
+    EXPECT_NE(md.find("Possible stand-ins set aside beside a residual beyond the usual one (rule 6), not named: on 2 of 3 sets; 1 of them not "
+                      "hidden in their set (a wrong label kept out), 1 hidden (a miss)."),
+              std::string::npos)
+        << md;
+    EXPECT_EQ(study["sets"][0]["found"], json({"thermal_memory"}));
+    EXPECT_EQ(study["sets"][0]["stand_ins"], json({"rosin_temperature_shift"}));
+    EXPECT_NE(md.find("(possible stand-in, not named: rosin_temperature_shift)"), std::string::npos) << md;
+    // the shift set aside is no false positive, the contact set aside no detection
+    EXPECT_NE(md.find("| rosin_temperature_shift | 0 | 0 (0 %) | 0 of 3 (0 %)"), std::string::npos) << md;
+    EXPECT_NE(md.find("| hertzian_contact | 1 | 0 (0 %) | 0 of 2 (0 %)"), std::string::npos) << md;
+    fs::remove_all(dir);
+}
+
+// A plan.json that is not JSON is named with the file when a study is scored, as when it is run.
+TEST(Study, ScoringRefusesAnUnreadablePlanNamingTheFile)
+{
+    const fs::path dir = freshDir("badplan");
+    writeSet(dir, 0, {{"effects", json::array()}, {"params", json::object()}}, diagnosis(json::array({{{"effect", "none"}}})));
+    std::ofstream(dir / "plan.json") << "{\"rig\": {\"inharmonicity\": ";
+    try {
+        scoreStudy(dir);
+        ADD_FAILURE() << "a truncated plan.json was read";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("plan.json: unreadable"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir / "summary.md")) << "no half-written output";
+    fs::remove_all(dir);
+}
+
 TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
 {
     const fs::path dir = freshDir("nuisances");

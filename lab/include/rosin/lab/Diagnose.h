@@ -167,6 +167,10 @@ struct Diagnosis {
     std::string setName;
     EffectModel baseline, final;
     std::vector<Finding> findings;
+    /// Effects the rounds named that are set aside because the residual the final model leaves
+    /// is beyond the usual one: they lowered the error, but beside physics the model lacks they
+    /// may stand in for it (rule 6). Reported with their parameters, never as findings.
+    std::vector<Finding> standIns;
     /// Test strokes only: the baseline (with the calibrated nuisances) against the final model.
     double baselineError = 0, finalError = 0, relativeGain = 0, gainLow = 0, gainHigh = 0;
     std::size_t nFit = 0, nValidation = 0, nHeldout = 0; ///< nHeldout: the test strokes
