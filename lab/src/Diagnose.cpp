@@ -176,9 +176,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         char usual[32];
         std::snprintf(usual, sizeof usual, "%.3g", o.usualResidualRatio);
         d.rules.push_back("(6) When the final model leaves a residual beyond the usual one (more than " + std::string(usual) +
-                          " times the set's floor), the model lacks something on this rig, and a rate dependence, a rosin shift, a contact "
-                          "law or a rolling string can bend the friction to stand in for it: only thermal memory stays named, and the others "
-                          "are reported as possible stand-ins with their parameters, not as findings.");
+                          " times the set's floor), the model lacks something on this rig, and a rate dependence or a rosin shift (a further "
+                          "bend of the thermal law) or a rolling string (a softer bow point) can stand in for it: those are reported as possible "
+                          "stand-ins with their parameters, not as findings, while thermal memory and a contact law stay named.");
     }
 
     // 4. From the calibrated baseline, add effects one round at a time.

@@ -296,9 +296,10 @@ std::string usualResidualText(const Residual& r);
 /// noise) and what the final model leaves above it: which parts, where, and what it looks like.
 Residual measureResidual(const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& testSet,
                          const std::vector<ErrorParts>& currentTest, const std::vector<Prepared>& strokes, const DiagnoseOptions& o);
-/// Rule 6: beside a residual beyond the usual one, every finding but thermal memory moves to
-/// d.standIns (the model lacks something, and a further bend of the friction law or the contact
-/// can take its place). Returns how many were set aside.
+/// Rule 6: beside a residual beyond the usual one, a rate law, a rosin shift or a rolling string
+/// moves to d.standIns (the model lacks something, and a further bend of the thermal law or a
+/// softer bow point can take its place); thermal memory and a contact law stay named. Returns
+/// how many were set aside.
 std::size_t setAsideStandIns(Diagnosis& d);
 
 } // namespace rosin::lab::diag

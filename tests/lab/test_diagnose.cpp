@@ -229,10 +229,10 @@ TEST(DiagnoseParameters, AShiftThatFlipsSignBesideARateLawIsAStandIn)
 
 // A later round's torsion candidate is searched also from round 1's Z_t/Z_0 (the rest of the start
 // as the model has it), and only when round 1 fitted some torsion on the baseline.
-// Rule 6: beside a residual beyond the usual one, everything but thermal memory is set aside as
-// a possible stand-in, with its parameters; within the usual one (or with no comparison) the
-// findings stay as the rounds named them.
-TEST(DiagnoseParameters, BesideAnUnusualResidualOnlyThermalMemoryStaysNamed)
+// Rule 6: beside a residual beyond the usual one, a rate law, a rosin shift and a torsion are set
+// aside as possible stand-ins, with their parameters; thermal memory and a contact law stay.
+// Within the usual one (or with no comparison) the findings stay as the rounds named them.
+TEST(DiagnoseParameters, BesideAnUnusualResidualOnlyThermalMemoryAndAContactStayNamed)
 {
     const auto finding = [](const std::string& effect, const std::string& name, double value) {
         Finding f;
@@ -242,22 +242,25 @@ TEST(DiagnoseParameters, BesideAnUnusualResidualOnlyThermalMemoryStaysNamed)
     };
     Diagnosis d;
     d.findings = {finding("thermal_memory", "r_A", 1.35), finding("rosin_temperature_shift", "shift_k", 25.0),
-                  finding("hertzian_contact", "load_exponent", 0.7)};
+                  finding("hertzian_contact", "load_exponent", 0.7), finding("torsional_compliance", "zt_ratio", 1.4),
+                  finding("rate_dependence", "p", 0.3)};
     d.residual.present = true;
     d.residual.ratio = 8.8;
     d.residual.usual = 8.6;
     Diagnosis within = d;
     EXPECT_EQ(diag::setAsideStandIns(within), 0u) << "beyond_usual not set: nothing moves";
-    EXPECT_EQ(within.findings.size(), 3u);
+    EXPECT_EQ(within.findings.size(), 5u);
     EXPECT_TRUE(within.standIns.empty());
     d.residual.beyondUsual = true;
-    EXPECT_EQ(diag::setAsideStandIns(d), 2u);
-    ASSERT_EQ(d.findings.size(), 1u);
+    EXPECT_EQ(diag::setAsideStandIns(d), 3u);
+    ASSERT_EQ(d.findings.size(), 2u);
     EXPECT_EQ(d.findings[0].effect, "thermal_memory");
-    ASSERT_EQ(d.standIns.size(), 2u);
+    EXPECT_EQ(d.findings[1].effect, "hertzian_contact");
+    ASSERT_EQ(d.standIns.size(), 3u);
     EXPECT_EQ(d.standIns[0].effect, "rosin_temperature_shift");
     EXPECT_EQ(d.standIns[0].parameters.at("shift_k")[0], 25.0);
-    EXPECT_EQ(d.standIns[1].effect, "hertzian_contact");
+    EXPECT_EQ(d.standIns[1].effect, "torsional_compliance");
+    EXPECT_EQ(d.standIns[2].effect, "rate_dependence");
     EXPECT_EQ(diag::setAsideStandIns(d), 0u) << "applied twice, it moves nothing more";
 }
 

@@ -404,9 +404,9 @@ TEST(Study, CountsTheStandInsSetAsideBesideAnUnusualResidualAndDoesNotScoreThemA
     // set 0 hides a rate law; the rounds fitted a shift in its place, set aside
     writeSet(dir, 0, {{"effects", {"thermal_memory", "rate_dependence"}}, {"params", {{"r_A", 1.08}, {"p", 0.54}}}},
              beyond(thermalDiagnosis(1.2, 1.0, 1.4, json::object()), json::array({finding("rosin_temperature_shift", "shift_k", 25.0, 5.0, 30.0)})));
-    // set 1 hides a contact, and the contact it found is set aside too
-    writeSet(dir, 1, {{"effects", {"thermal_memory", "hertzian_contact"}}, {"params", {{"r_A", 1.0}, {"load_exponent", 0.7}}}},
-             beyond(thermalDiagnosis(1.02, 0.9, 1.1, json::object()), json::array({finding("hertzian_contact", "load_exponent", 0.72, 0.6, 0.8)})));
+    // set 1 hides a rolling string, and the torsion it found is set aside too
+    writeSet(dir, 1, {{"effects", {"thermal_memory", "torsional_compliance"}}, {"params", {{"r_A", 1.0}, {"zt_ratio", 1.5}}}},
+             beyond(thermalDiagnosis(1.02, 0.9, 1.1, json::object()), json::array({finding("torsional_compliance", "zt_ratio", 1.6, 1.2, 2.1)})));
     writeSet(dir, 2, {{"effects", json::array()}, {"params", json::object()}}, beyond(diagnosis(json::array({{{"effect", "none"}}})), json::array()));
     const std::string md = scoreStudy(dir);
     json study;
@@ -422,9 +422,9 @@ TEST(Study, CountsTheStandInsSetAsideBesideAnUnusualResidualAndDoesNotScoreThemA
     EXPECT_EQ(study["sets"][0]["found"], json({"thermal_memory"}));
     EXPECT_EQ(study["sets"][0]["stand_ins"], json({"rosin_temperature_shift"}));
     EXPECT_NE(md.find("(possible stand-in, not named: rosin_temperature_shift)"), std::string::npos) << md;
-    // the shift set aside is no false positive, the contact set aside no detection
+    // the shift set aside is no false positive, the torsion set aside no detection
     EXPECT_NE(md.find("| rosin_temperature_shift | 0 | 0 (0 %) | 0 of 3 (0 %)"), std::string::npos) << md;
-    EXPECT_NE(md.find("| hertzian_contact | 1 | 0 (0 %) | 0 of 2 (0 %)"), std::string::npos) << md;
+    EXPECT_NE(md.find("| torsional_compliance | 1 | 0 (0 %) | 0 of 2 (0 %)"), std::string::npos) << md;
     fs::remove_all(dir);
 }
 
