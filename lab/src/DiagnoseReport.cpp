@@ -385,16 +385,22 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         canvas.save(dir / "loops.png");
     }
 
+    // A diagnosis always has strokes; one made by hand for a test may not, and gets no figures.
+    const bool strokesShown = !d.ids.empty();
     const std::string shown = mapGesture(d);
-    const SweepResult measured = asMap(d, d.measured, "measured", shown), base = asMap(d, d.baselineSim, "baseline: " + d.baseline.name(), shown),
-                      fin = asMap(d, d.finalSim, "final: " + d.final.name(), shown);
-    DiagramOptions dopt;
-    dopt.bounds = false;
-    if (shown == "exp_speed") dopt.xLabel = "initial bow acceleration v0/tv (m/s\u00b2)";
-    if (shown == "exp_force") dopt.xLabel = "bow speed (m/s)";
-    writePanelPng(dir / "maps.png", {measured, base, fin}, {"measured", "baseline: " + d.baseline.name(), "final: " + d.final.name()}, 3, dopt);
-    overlays(dir / "overlays.png", d);
-    jumps(dir / "jumps.png", d);
+    SweepResult measured, base, fin;
+    if (strokesShown) {
+        measured = asMap(d, d.measured, "measured", shown);
+        base = asMap(d, d.baselineSim, "baseline: " + d.baseline.name(), shown);
+        fin = asMap(d, d.finalSim, "final: " + d.final.name(), shown);
+        DiagramOptions dopt;
+        dopt.bounds = false;
+        if (shown == "exp_speed") dopt.xLabel = "initial bow acceleration v0/tv (m/s\u00b2)";
+        if (shown == "exp_force") dopt.xLabel = "bow speed (m/s)";
+        writePanelPng(dir / "maps.png", {measured, base, fin}, {"measured", "baseline: " + d.baseline.name(), "final: " + d.final.name()}, 3, dopt);
+        overlays(dir / "overlays.png", d);
+        jumps(dir / "jumps.png", d);
+    }
 
     std::ofstream md(dir / "report.md");
     md << "# Diagnosis of " << d.setName << "\n\n";
@@ -468,14 +474,16 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         }
         md << "\n";
     }
-    const BoundaryFit bm = fitLowerBoundary(measured), bb = fitLowerBoundary(base), bf = fitLowerBoundary(fin);
-    md << "## Guettler maps\n\n![maps](maps.png)\n\n";
-    if (std::any_of(d.gestures.begin(), d.gestures.end(), [&](const std::string& g) { return g != shown; }))
-        md << "The maps show the set's " << shown << " strokes; its other strokes are in every error and fit above but not on the maps.\n\n";
-    md << "Helmholtz cells: measured " << measured.successCount() << ", baseline "
-       << base.successCount() << ", final " << fin.successCount() << " of " << measured.cells.size() << ". Lower-boundary exponent p: measured "
-       << (bm.valid ? fmt(bm.p) : "n/a") << ", baseline " << (bb.valid ? fmt(bb.p) : "n/a") << ", final " << (bf.valid ? fmt(bf.p) : "n/a") << ".\n\n";
-    md << "## Waveforms\n\n![overlays](overlays.png)\n\n## First-slip jumps\n\n![jumps](jumps.png)\n\n";
+    if (strokesShown) {
+        const BoundaryFit bm = fitLowerBoundary(measured), bb = fitLowerBoundary(base), bf = fitLowerBoundary(fin);
+        md << "## Guettler maps\n\n![maps](maps.png)\n\n";
+        if (std::any_of(d.gestures.begin(), d.gestures.end(), [&](const std::string& g) { return g != shown; }))
+            md << "The maps show the set's " << shown << " strokes; its other strokes are in every error and fit above but not on the maps.\n\n";
+        md << "Helmholtz cells: measured " << measured.successCount() << ", baseline "
+           << base.successCount() << ", final " << fin.successCount() << " of " << measured.cells.size() << ". Lower-boundary exponent p: measured "
+           << (bm.valid ? fmt(bm.p) : "n/a") << ", baseline " << (bb.valid ? fmt(bb.p) : "n/a") << ", final " << (bf.valid ? fmt(bf.p) : "n/a") << ".\n\n";
+        md << "## Waveforms\n\n![overlays](overlays.png)\n\n## First-slip jumps\n\n![jumps](jumps.png)\n\n";
+    }
     if (!d.loops.empty()) {
         md << "## Two-ended strokes (Schumacher)\n\n![loops](loops.png)\n\n| stroke | measured loop | final model |\n|---|---|---|\n";
         for (const auto& l : d.loops)

@@ -15,6 +15,8 @@ void drawGuettler(Canvas& canvas, double left, double top, double width, double 
 {
     const auto& A = r.spec.accelerations;
     const auto& F = r.spec.forces;
+    if (A.empty() || F.empty() || r.cells.size() < A.size() * F.size() * (ib + 1))
+        throw LabError("a Guettler diagram needs a result for every bow acceleration and force of its grid (at least one of each)");
     const double da = A.size() > 1 ? A[1] - A[0] : A[0], dF = F.size() > 1 ? F[1] - F[0] : F[0];
     const double aMax = A.back() + da / 2, fMax = F.back() + dF / 2;
     Axes ax(canvas, left, top, width, height, 0.0, aMax, 0.0, fMax);

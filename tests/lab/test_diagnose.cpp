@@ -8,10 +8,13 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <numeric>
 #include <random>
 #include <set>
+
+#include <nlohmann/json.hpp>
 
 #include "rosin/dsp.h"
 #include "rosin/lab/Diagnose.h"
@@ -262,6 +265,32 @@ TEST(DiagnoseParameters, BesideAnUnusualResidualOnlyThermalMemoryAndAContactStay
     EXPECT_EQ(d.standIns[1].effect, "torsional_compliance");
     EXPECT_EQ(d.standIns[2].effect, "rate_dependence");
     EXPECT_EQ(diag::setAsideStandIns(d), 0u) << "applied twice, it moves nothing more";
+
+    // What a user reads: diagnosis.json lists the stand-ins under the residual with their
+    // intervals and keeps them out of the findings; report.md gives them a section and rule 6.
+    d.rules = {"(6) beside an unusual residual ..."};
+    const fs::path dir = fs::temp_directory_path() / ("rosin-standins-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    writeDiagnosis(dir, d, DiagnoseOptions{});
+    nlohmann::json doc;
+    std::ifstream(dir / "diagnosis.json") >> doc;
+    ASSERT_EQ(doc["findings"].size(), 2u);
+    EXPECT_EQ(doc["findings"][0]["effect"], "thermal_memory");
+    EXPECT_EQ(doc["findings"][1]["effect"], "hertzian_contact");
+    const auto& standIns = doc["unexplained_residual"]["stand_ins"];
+    ASSERT_EQ(standIns.size(), 3u);
+    EXPECT_EQ(standIns[0]["effect"], "rosin_temperature_shift");
+    EXPECT_DOUBLE_EQ(standIns[0]["parameters"]["shift_k"]["value"].get<double>(), 25.0);
+    EXPECT_EQ(standIns[0]["parameters"]["shift_k"]["ci95"].size(), 2u);
+    EXPECT_TRUE(doc["unexplained_residual"]["beyond_usual"].get<bool>());
+    std::ifstream in(dir / "report.md");
+    const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(md.find("### Possible stand-ins (not named)"), std::string::npos) << md;
+    EXPECT_NE(md.find("The rounds named rosin_temperature_shift, torsional_compliance and rate_dependence under rules 1-5"), std::string::npos) << md;
+    EXPECT_NE(md.find("| rosin_temperature_shift | shift_k | 25 |"), std::string::npos) << md;
+    EXPECT_EQ(md.find("### rosin_temperature_shift"), std::string::npos) << "a stand-in has no finding's section";
+    EXPECT_NE(md.find("### thermal_memory"), std::string::npos);
+    fs::remove_all(dir);
 }
 
 TEST(DiagnoseParameters, ALaterTorsionSearchAlsoStartsWhereRoundOneLeftItsZt)

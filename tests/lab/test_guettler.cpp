@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "rosin/lab/Error.h"
 #include "rosin/lab/Figures.h"
 #include "rosin/lab/Guettler.h"
 
@@ -255,6 +256,21 @@ TEST(GuettlerBounds, MatchThePhysicsReferenceNumbers)
     const auto b = guettlerBounds(dsp::StringParams::celloD(), 0.0899, 1.2, 0.35);
     EXPECT_NEAR(b.lowerPerAccel, 0.26, 0.01); // 0.26 a <= F < 0.37 a (PHYSICS.md 6.3)
     EXPECT_NEAR(b.upperPerAccel, 0.37, 0.01);
+}
+
+// A diagram of a sweep with no cells (or fewer than its grid) is refused with a clear error,
+// and no PNG is written (it once read past the empty grid).
+TEST(GuettlerBounds, ADiagramOfAnEmptySweepIsRefused)
+{
+    const std::filesystem::path file = std::filesystem::temp_directory_path() / ("rosin-empty-sweep-" + std::to_string(::getpid()) + ".png");
+    std::filesystem::remove(file);
+    EXPECT_THROW(rosin::lab::writePanelPng(file, {rosin::lab::SweepResult{}}, {"empty"}, 1, rosin::lab::DiagramOptions{}), rosin::lab::LabError);
+    rosin::lab::SweepResult partial;
+    partial.spec.accelerations = {0.5, 1.0};
+    partial.spec.forces = {0.2, 0.4};
+    partial.cells.resize(3); // one short of its 2 x 2 grid
+    EXPECT_THROW(rosin::lab::writePanelPng(file, {partial}, {"partial"}, 1, rosin::lab::DiagramOptions{}), rosin::lab::LabError);
+    EXPECT_FALSE(std::filesystem::exists(file));
 }
 
 TEST(GuettlerCli, WritesTablesAndADiagramAndRejectsBadAxes)
