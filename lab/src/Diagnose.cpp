@@ -172,14 +172,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                "After each new finding every earlier one must still earn its place: the model is refitted without it, and an effect whose "
                "absence raises the validation error by less than the naming threshold is dropped and not tried again.",
                "The reported gain compares the calibrated baseline and the final model on the test strokes only."};
-    if (o.usualResidualRatio > 0.0) {
-        char usual[32];
-        std::snprintf(usual, sizeof usual, "%.3g", o.usualResidualRatio);
-        d.rules.push_back("(6) When the final model leaves a residual beyond the usual one (more than " + std::string(usual) +
-                          " times the set's floor), the model lacks something on this rig, and a rate dependence or a rosin shift (a further "
-                          "bend of the thermal law) or a rolling string (a softer bow point) can stand in for it: those are reported as possible "
-                          "stand-ins with their parameters, not as findings, while thermal memory and a contact law stay named.");
-    }
+    if (o.usualResidualRatio > 0.0) d.rules.push_back(standInRuleText(o.usualResidualRatio));
 
     // 4. From the calibrated baseline, add effects one round at a time.
     int round = 0;

@@ -301,5 +301,7 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
 /// softer bow point can take its place); thermal memory and a contact law stay named. Returns
 /// how many were set aside.
 std::size_t setAsideStandIns(Diagnosis& d);
+/// Rule 6 in words, with the usual ratio it applies beyond, for the report's rules.
+std::string standInRuleText(double usualRatio);
 
 } // namespace rosin::lab::diag

@@ -137,6 +137,16 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
         return r;
 }
 
+std::string standInRuleText(double usualRatio)
+{
+    char usual[32];
+    std::snprintf(usual, sizeof usual, "%.3g", usualRatio);
+    return "(6) When the final model leaves a residual beyond the usual one (more than " + std::string(usual) +
+           " times the set's floor), the model lacks something on this rig, and a rate dependence or a rosin shift (a further "
+           "bend of the thermal law) or a rolling string (a softer bow point) can stand in for it: those are reported as possible "
+           "stand-ins with their parameters, not as findings, while thermal memory and a contact law stay named.";
+}
+
 std::size_t setAsideStandIns(Diagnosis& d)
 {
     if (!d.residual.beyondUsual) return 0;

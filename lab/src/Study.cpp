@@ -368,7 +368,7 @@ std::string scoreStudy(const fs::path& dir)
     for (const auto& s : sets) {
         standInSets += !s.standIns.empty();
         for (const auto& e : s.standIns) {
-            if (std::find(s.hidden.begin(), s.hidden.end(), e) != s.hidden.end()) ++standInsHidden;
+            if (has(s.hidden, e)) ++standInsHidden;
             else ++standInsNotHidden;
         }
     }
