@@ -161,7 +161,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                "with a 95 % paired-bootstrap interval above 0, (2) the fall is at least " + std::to_string(static_cast<int>(std::lround(100 * o.namingThreshold))) +
                    " % of the validation error (threshold calibrated on null sets), and a candidate that brings thermal memory along "
                    "(rate dependence, a rosin shift) also falls below thermal memory alone by that share, and a rate dependence or a rosin shift also below the other of the two, "
-                   "fitted in the same round, by that share (else the data do not tell them apart); a rosin shift fitted beside a named rate dependence "
+                   "fitted in the same round, by that share (else the data do not tell them apart)" + shiftMarginText(o) + "; a rosin shift fitted beside a named rate dependence "
                    "must not have the other sign than round 1's shift candidate when that one was 10 K or more (else it stands in for the rate law's form), (3) it also lowers the error of the test strokes, "
                    "(4) the 95 % interval of its parameter excludes the no-effect value (exponent 1, shift 0 K, "
                    "Z_t/Z_0 >= 7.5, speed exponent <= 0.03), both the bootstrap refits' interval and that interval widened in quadrature "
@@ -246,7 +246,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 pinned = pinned || std::min(t.x[k] - t.c.lo[k], t.c.hi[k] - t.x[k]) < kEdgeShare * (t.c.hi[k] - t.c.lo[k]);
             if (pinned) { trial.verdict = "fitted at the edge of its search range (a stand-in, not a measurement)"; continue; }
             // Rule 2's comparisons with the round's other candidates (docs/diagnosis.md).
-            if (const std::string failed = standInVerdict(trial, t.c, roundValidation, current.effects, d.trials, o.namingThreshold); !failed.empty()) {
+            if (const std::string failed = standInVerdict(trial, t.c, roundValidation, current.effects, d.trials, o.namingThreshold, o.shiftOverRateMargin); !failed.empty()) {
                 trial.verdict = failed;
                 continue;
             }

@@ -197,6 +197,9 @@ std::optional<double> nameableEdge(const DiagnoseOptions& o, const std::string& 
 /// "; with it no shift under 15.7 K, ... can be named, whatever the scatter": nameableEdge of every
 /// parameter with a model discrepancy, in words for the report's rules ("" when none has one).
 std::string nameableEdgesText(const DiagnoseOptions& o);
+/// Rule 2's larger margin for a rosin shift over a rate law, in words ("" when it is no larger
+/// than the naming threshold).
+std::string shiftMarginText(const DiagnoseOptions& o);
 /// Rule 4 asked again of an earlier finding after a later joint refit moved its parameters to
 /// `now`: does the interval it was named with (the same bootstrap half-width around the new
 /// value, widened by the model discrepancy as rule 4 widens it) reach the no-effect value?
@@ -206,10 +209,12 @@ double relativeFall(double before, double after);
 /// Rule 2's comparisons of candidate `c` (fitted as `trial`) with the round's other candidates,
 /// whose validation errors `roundValidation` holds by effect: one that brings thermal memory along
 /// must fall below thermal memory alone, and a rate dependence or a rosin shift below the other,
-/// each by `threshold` (the shares go into the trial); a shift beside a named rate law must not
-/// flip round 1's sign. Returns the failed rule's verdict, or "" when the candidate passes.
+/// each by `threshold` (the shares go into the trial), a shift below the rate law by
+/// `shiftOverRateMargin` when that is larger; a shift beside a named rate law must not flip
+/// round 1's sign. Returns the failed rule's verdict, or "" when the candidate passes.
 std::string standInVerdict(Trial& trial, const Candidate& c, const std::map<std::string, double>& roundValidation,
-                           const std::vector<std::string>& namedEffects, const std::vector<Trial>& trials, double threshold);
+                           const std::vector<std::string>& namedEffects, const std::vector<Trial>& trials, double threshold,
+                           double shiftOverRateMargin = 0.0);
 /// A second start for a later round's torsion candidate: its own parameter where round 1 left it
 /// on the baseline (the rest where the model has them), unless round 1 fitted no torsion there.
 std::optional<std::vector<double>> roundOneStart(const std::vector<Trial>& trials, const Candidate& c);

@@ -373,6 +373,19 @@ TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneA
               "sign flipped beside rate_dependence (round 1 asked for the other sign): a stand-in for the rate law's form");
     t = trialOf("rosin_temperature_shift", -26.5);
     EXPECT_EQ(diag::standInVerdict(t, shift, besideRate, {"thermal_memory"}, earlier, 0.05), "");
+    // a shift's larger margin over a rate law: 0.18 against 0.22 is 18 % better, enough for the
+    // threshold and not for a 30 % margin; the same margin leaves a rate law at the threshold
+    t = trialOf("rosin_temperature_shift", 23.0);
+    const std::map<std::string, double> close{{"thermal_memory", 0.30}, {"rosin_temperature_shift", 0.18}, {"rate_dependence", 0.22}};
+    EXPECT_EQ(diag::standInVerdict(t, shift, close, {}, {}, 0.05), "");
+    EXPECT_NEAR(t.overRival, 0.04 / 0.22, 1e-12);
+    t = trialOf("rosin_temperature_shift", 23.0);
+    EXPECT_EQ(diag::standInVerdict(t, shift, close, {}, {}, 0.05, 0.3),
+              "18 % better than rate_dependence, under the 30 % a rosin shift must clear (a missing stiffness or contact constant gives a shift that margin)");
+    t = trialOf("rosin_temperature_shift", 23.0);
+    EXPECT_EQ(diag::standInVerdict(t, shift, close, {}, {}, 0.05, 0.17), "");
+    r = trialOf("rate_dependence", 0.0);
+    EXPECT_EQ(diag::standInVerdict(r, rate, {{"thermal_memory", 0.30}, {"rosin_temperature_shift", 0.22}, {"rate_dependence", 0.18}}, {}, {}, 0.05, 0.3), "");
     // a contact or torsion is not compared with anything here
     diag::Candidate contact;
     contact.effect = "hertzian_contact";

@@ -405,7 +405,7 @@ TEST(DiagnoseCli, WritesTheDiagnosisAndRefusesABrokenSetWritingNothing)
         return std::make_pair(WEXITSTATUS(status), text);
     };
     ASSERT_EQ(run(cli + " synth-data --grid 4 --seed 9 -q -o " + (d / "set").string()).first, 0);
-    const auto ok = run(cli + " diagnose " + (d / "set").string() + " --max-evaluations 8 -o " + (d / "out").string());
+    const auto ok = run(cli + " diagnose " + (d / "set").string() + " --max-evaluations 8 --shift-margin 0.25 -o " + (d / "out").string());
     ASSERT_EQ(ok.first, 0) << ok.second;
     for (const char* f : {"diagnosis.json", "report.md", "maps.png", "overlays.png", "jumps.png", "split.json", "two_ended.json", "loops.png"})
         EXPECT_TRUE(fs::exists(d / "out" / f)) << f;
@@ -415,6 +415,8 @@ TEST(DiagnoseCli, WritesTheDiagnosisAndRefusesABrokenSetWritingNothing)
                             "\"final_model\"", "\"gain\"", "\"ci95\"", "\"n_fit\": 8", "\"n_validation\": 4", "\"n_heldout\": 4", "\"unexplained_residual\"", "\"calibration\"",
                             "\"scale_n_per_unit\"", "\"warnings\""})
         EXPECT_NE(json.find(key), std::string::npos) << key;
+    // the rules printed are the ones applied: the shift's margin as given
+    EXPECT_NE(json.find("a rosin shift below the rate dependence by 25 %"), std::string::npos);
     // A broken set: refused, naming the file and field, and no output folder appears.
     fs::remove(d / "set" / "transients" / "a01_f01.wav");
     const auto bad = run(cli + " diagnose " + (d / "set").string() + " -o " + (d / "out2").string());

@@ -63,6 +63,11 @@ struct DiagnoseCommand {
                                 "above it is reported as more than the usual difference (0 = no comparison)")
             ->check(finiteIn(0, 1000))
             ->capture_default_str();
+        diagnoseCmd->add_option("--shift-margin", diagOptions.shiftOverRateMargin,
+                                "Least validation-error fall (share) of a rosin shift below the rate dependence fitted in the same round "
+                                "(the naming threshold when smaller)")
+            ->check(finiteIn(0, 1))
+            ->capture_default_str();
         diagnoseCmd->add_option("--model-discrepancy", discrepancy,
                                 "NAME=SD: the model's own error for parameter NAME (r_A and zt_ratio relative, others absolute; 0 = none), "
                                 "instead of the study-calibrated default (" + defaultDiscrepancyText() + ")");

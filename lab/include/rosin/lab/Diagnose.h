@@ -70,6 +70,11 @@ struct DiagnoseOptions {
     /// residual above it is more than that usual difference. Measured by `rosin study` (seed 2047:
     /// docs/diagnosis-study.md); 0 = no comparison.
     double usualResidualRatio = 8.6;
+    /// A rosin shift must beat the rate dependence fitted in the same round by this share of the
+    /// latter's validation error (a rate law the threshold): beside a rate law, a string stiffer
+    /// than the model's bends the fitted thermal law as a +22 to +25 K shift does, by 0.08-0.29,
+    /// where true shifts won by 0.32-0.77 (docs/diagnosis-study.md). 0 = the threshold alone.
+    double shiftOverRateMargin = 0.3;
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     /// The model's own error on rigs it does not describe (their thermal constants, an unnamed
     /// torsion): the standard deviation that a finding's parameter still misses the truth by
