@@ -379,8 +379,11 @@ TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temp
 // Rule 6 on the set that made it: seed 2101's set 8, a rate law (p 0.54) on a string ten times
 // stiffer than the rig prior's stiffest, built as `rosin study --seed 2101 --rig-param
 // inharmonicity=1e-3` builds it. Before rule 6 it was named thermal memory and a +25 K rosin
-// shift. Now thermal memory alone is named, the residual is beyond the usual one, and the shift
-// is reported as a possible stand-in: no label the set does not hide.
+// shift, which beat the rate law by 28.5 %; rule 6 then set it aside as a stand-in beside a
+// residual beyond the usual one. Rule 2's 30 % margin for a shift over a rate law now refuses
+// it before that. Thermal memory alone fits this stiff string worse than the baseline (-3.6 %)
+// and the rate law does not beat the shift, so nothing is named: a miss, reported as a
+// residual beyond the usual one, and no label the set does not hide.
 TEST(DiagnoseReferenceLong, ARateLawOnAFarStifferStringIsNotNamedAsARosinShift)
 {
     const fs::path dir = fs::temp_directory_path() / ("rosin-diagref-stiff-" + std::to_string(::getpid()));
@@ -398,12 +401,17 @@ TEST(DiagnoseReferenceLong, ARateLawOnAFarStifferStringIsNotNamedAsARosinShift)
     fs::remove_all(dir);
     std::vector<std::string> found;
     for (const auto& f : d.findings) found.push_back(f.effect);
-    EXPECT_EQ(found, std::vector<std::string>{"thermal_memory"});
     for (const auto& e : found) EXPECT_NE(std::find(truth.effects.begin(), truth.effects.end(), e), truth.effects.end()) << e << " not hidden";
     EXPECT_TRUE(d.residual.beyondUsual) << d.residual.ratio << " floors";
-    ASSERT_EQ(d.standIns.size(), 1u);
-    EXPECT_EQ(d.standIns[0].effect, "rosin_temperature_shift");
-    EXPECT_GT(d.standIns[0].parameters.at("shift_k")[0], 15.0) << "the shift that stood in for the rate law";
+    for (const auto& s : d.standIns) EXPECT_NE(s.effect, "rosin_temperature_shift");
+    // the shift that stood in for the rate law: large, ahead of the rate law, and refused by the margin
+    const auto refused = std::find_if(d.trials.begin(), d.trials.end(), [](const Trial& t) {
+        return t.effect == "rosin_temperature_shift" && t.verdict.find("a rosin shift must clear") != std::string::npos;
+    });
+    ASSERT_NE(refused, d.trials.end());
+    EXPECT_GT(refused->parameters.at("shift_k"), 15.0);
+    EXPECT_GT(refused->overRival, 0.05);
+    EXPECT_LT(refused->overRival, 0.3);
 }
 
 // Effects and rigs drawn truly at random from a seed printed here: run by hand or in `long`.
