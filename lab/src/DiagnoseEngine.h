@@ -214,7 +214,7 @@ double relativeFall(double before, double after);
 /// round 1's sign. Returns the failed rule's verdict, or "" when the candidate passes.
 std::string standInVerdict(Trial& trial, const Candidate& c, const std::map<std::string, double>& roundValidation,
                            const std::vector<std::string>& namedEffects, const std::vector<Trial>& trials, double threshold,
-                           double shiftOverRateMargin = 0.0);
+                           double shiftOverRateMargin);
 /// A second start for a later round's torsion candidate: its own parameter where round 1 left it
 /// on the baseline (the rest where the model has them), unless round 1 fitted no torsion there.
 std::optional<std::vector<double>> roundOneStart(const std::vector<Trial>& trials, const Candidate& c);

@@ -345,18 +345,18 @@ TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneA
     };
     // 0.20 alone, 0.18 with a shift: 10 % better; the rate law at 0.185: 2.7 % behind the shift
     Trial t = trialOf("rosin_temperature_shift", 12.0);
-    EXPECT_EQ(diag::standInVerdict(t, shift, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.18}, {"rate_dependence", 0.185}}, {}, {}, 0.05),
+    EXPECT_EQ(diag::standInVerdict(t, shift, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.18}, {"rate_dependence", 0.185}}, {}, {}, 0.05, 0.0),
               "no better than rate_dependence (the data do not tell the two apart)");
     EXPECT_NEAR(t.overThermal, 0.10, 1e-12);
     EXPECT_NEAR(t.overRival, 0.005 / 0.185, 1e-12);
     // 0.191 with the shift is 4.5 % under 0.20 alone: the thermal rule fails first, the rival is not judged
     t = trialOf("rosin_temperature_shift", 12.0);
-    EXPECT_EQ(diag::standInVerdict(t, shift, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.191}, {"rate_dependence", 0.30}}, {}, {}, 0.05),
+    EXPECT_EQ(diag::standInVerdict(t, shift, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.191}, {"rate_dependence", 0.30}}, {}, {}, 0.05, 0.0),
               "no better than thermal_memory alone");
     EXPECT_EQ(t.overRival, 0.0);
     // the rate law well ahead of both: passes, and its shares are recorded
     Trial r = trialOf("rate_dependence", 0.0);
-    EXPECT_EQ(diag::standInVerdict(r, rate, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.18}, {"rate_dependence", 0.10}}, {}, {}, 0.05), "");
+    EXPECT_EQ(diag::standInVerdict(r, rate, {{"thermal_memory", 0.20}, {"rosin_temperature_shift", 0.18}, {"rate_dependence", 0.10}}, {}, {}, 0.05, 0.0), "");
     EXPECT_NEAR(r.overThermal, 0.5, 1e-12);
     EXPECT_NEAR(r.overRival, 0.08 / 0.18, 1e-12);
     // beside a named rate law (no rate candidate this round) a shift that flipped round 1's sign fails
@@ -369,15 +369,15 @@ TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneA
     }()};
     const std::map<std::string, double> besideRate{{"rosin_temperature_shift", 0.10}};
     t = trialOf("rosin_temperature_shift", -26.5);
-    EXPECT_EQ(diag::standInVerdict(t, shift, besideRate, {"thermal_memory", "rate_dependence"}, earlier, 0.05),
+    EXPECT_EQ(diag::standInVerdict(t, shift, besideRate, {"thermal_memory", "rate_dependence"}, earlier, 0.05, 0.0),
               "sign flipped beside rate_dependence (round 1 asked for the other sign): a stand-in for the rate law's form");
     t = trialOf("rosin_temperature_shift", -26.5);
-    EXPECT_EQ(diag::standInVerdict(t, shift, besideRate, {"thermal_memory"}, earlier, 0.05), "");
+    EXPECT_EQ(diag::standInVerdict(t, shift, besideRate, {"thermal_memory"}, earlier, 0.05, 0.0), "");
     // a shift's larger margin over a rate law: 0.18 against 0.22 is 18 % better, enough for the
     // threshold and not for a 30 % margin; the same margin leaves a rate law at the threshold
     t = trialOf("rosin_temperature_shift", 23.0);
     const std::map<std::string, double> close{{"thermal_memory", 0.30}, {"rosin_temperature_shift", 0.18}, {"rate_dependence", 0.22}};
-    EXPECT_EQ(diag::standInVerdict(t, shift, close, {}, {}, 0.05), "");
+    EXPECT_EQ(diag::standInVerdict(t, shift, close, {}, {}, 0.05, 0.0), "");
     EXPECT_NEAR(t.overRival, 0.04 / 0.22, 1e-12);
     t = trialOf("rosin_temperature_shift", 23.0);
     EXPECT_EQ(diag::standInVerdict(t, shift, close, {}, {}, 0.05, 0.3),
@@ -390,7 +390,7 @@ TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneA
     diag::Candidate contact;
     contact.effect = "hertzian_contact";
     t = trialOf("hertzian_contact", 0.0);
-    EXPECT_EQ(diag::standInVerdict(t, contact, {{"hertzian_contact", 0.5}, {"thermal_memory", 0.1}}, {}, {}, 0.05), "");
+    EXPECT_EQ(diag::standInVerdict(t, contact, {{"hertzian_contact", 0.5}, {"thermal_memory", 0.1}}, {}, {}, 0.05, 0.0), "");
 }
 
 // A bootstrap resample repeats strokes; the engine simulates each distinct stroke once and scores

@@ -376,7 +376,7 @@ TEST(DiagnoseReferenceLong, FindsARollingStringBesideThermalMemory)
 
 TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temperature_shift"}, {{"r_A", 1.2}, {"shift_k", -14.0}}, 45)); }
 
-// Rule 6 on the set that made it: seed 2101's set 8, a rate law (p 0.54) on a string ten times
+// The set that made rule 6 and now meets rule 2's shift margin first: seed 2101's set 8, a rate law (p 0.54) on a string ten times
 // stiffer than the rig prior's stiffest, built as `rosin study --seed 2101 --rig-param
 // inharmonicity=1e-3` builds it. Before rule 6 it was named thermal memory and a +25 K rosin
 // shift, which beat the rate law by 28.5 %; rule 6 then set it aside as a stand-in beside a
