@@ -23,7 +23,6 @@ namespace rosin::lab {
 
 namespace {
 /// A fitted parameter closer than this share of its search range to either end is pinned there.
-constexpr double kEdgeShare = 0.01;
 bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
 } // namespace
 
@@ -238,17 +237,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             std::map<std::string, double> fitted;
             for (std::size_t j = 0; j < t.c.names.size(); ++j) fitted[t.c.names[j]] = t.x[j];
             if (atNull(t.c.effect, fitted)) { trial.verdict = "fitted at the effect's own absence"; continue; }
-            // A parameter that ends on the edge of its search range is pushed past what the
-            // candidate can express: it stands in for something else (a thermal model asked to
-            // fit a Hertzian contact drives its rosin shift to +30 K), and its value is no measurement.
-            // A parameter the data cannot fix (h0) has no force on it: it ends wherever the search
-            // drifted, an edge included, and says nothing of the candidate (seed 2049, set 5: a
-            // rate law 57 % better refused for h0 at 1.2).
-            bool pinned = false;
-            for (std::size_t k = 0; k < t.c.scanned; ++k)
-                pinned = pinned || (identifiable(t.c.names[k]) &&
-                                    std::min(t.x[k] - t.c.lo[k], t.c.hi[k] - t.x[k]) < kEdgeShare * (t.c.hi[k] - t.c.lo[k]));
-            if (pinned) { trial.verdict = "fitted at the edge of its search range (a stand-in, not a measurement)"; continue; }
+            if (pinnedAtEdge(t.c, t.x)) { trial.verdict = "fitted at the edge of its search range (a stand-in, not a measurement)"; continue; }
             // Rule 2's comparisons with the round's other candidates (docs/diagnosis.md).
             if (const std::string failed = standInVerdict(trial, t.c, roundValidation, current.effects, d.trials, o.namingThreshold, o.shiftOverRateMargin); !failed.empty()) {
                 trial.verdict = failed;
@@ -307,18 +296,10 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             if (atNullInterval) { trial.verdict = "interval reaches the no-effect value"; continue; }
             if (atNullWithDiscrepancy) { trial.verdict = "interval reaches the no-effect value once the model discrepancy is counted"; continue; }
             // (5) the two force halves of the fit strokes
-            bool halvesAgree = true;
             std::vector<std::vector<double>> halves;
             for (bool high : {false, true})
                 halves.push_back(diag::fit(engine, current, t.c, subset(fitSet, strokes, high), t.x, std::max(8, o.maxEvaluations / 2), 0.1, nullptr, false));
-            std::map<std::string, double> lowFit, highFit;
-            for (std::size_t k = 0; k < t.c.scanned; ++k) {
-                lowFit[t.c.names[k]] = halves[0][k];
-                highFit[t.c.names[k]] = halves[1][k];
-                const double spread = std::abs(halves[0][k] - halves[1][k]);
-                if (identifiable(t.c.names[k]) && spread > 2.0 * halfWidth[t.c.names[k]] + 0.1 * (t.c.hi[k] - t.c.lo[k])) halvesAgree = false;
-            }
-            if (atNull(t.c.effect, lowFit) || atNull(t.c.effect, highFit) || !halvesAgree) {
+            if (!halvesConsistent(t.c, halves[0], halves[1], halfWidth)) {
                 trial.verdict = "not consistent on the two drive halves (bow acceleration, or the gesture's own drive)";
                 continue;
             }

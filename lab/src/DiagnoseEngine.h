@@ -173,6 +173,15 @@ bool needsThermal(const std::string& effect);
 std::vector<Candidate> candidates(const EffectModel& m);
 /// True when the fitted parameters put the effect at its own absence.
 bool atNull(const std::string& effect, const std::map<std::string, double>& p);
+/// True when one of the candidate's own identifiable parameters ends within 1 % of its search
+/// range's edge (rule 1: a stand-in pushed past what the candidate can express). h0 is not asked:
+/// nothing fixes it, so it ends wherever the search drifted.
+bool pinnedAtEdge(const Candidate& c, const std::vector<double>& x);
+/// Rule 5: refits on the two drive halves agree when neither puts the effect at its absence and
+/// every identifiable parameter of the candidate's own differs between them by at most twice its
+/// bootstrap half-width plus a tenth of its search range.
+bool halvesConsistent(const Candidate& c, const std::vector<double>& low, const std::vector<double>& high,
+                      const std::map<std::string, double>& bootstrapHalfWidth);
 /// The model base with the candidate's effects added and its parameters set to x.
 EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x);
 /// Fits the candidate's parameters on the strokes `on`: a coarse grid, then COBYLA from its best point.
