@@ -22,7 +22,6 @@
 namespace rosin::lab {
 
 namespace {
-/// A fitted parameter closer than this share of its search range to either end is pinned there.
 bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
 } // namespace
 
@@ -167,7 +166,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                    "by the model discrepancy the studies measured (the one the report prints" + nameableEdgesText(o) + "), and (5) refitted on the low- and on the high-drive half of the fit strokes "
                    "(bow acceleration; v0/tv for exp_speed and bow speed for exp_force strokes, each gesture split at its own median) it keeps away from the no-effect value with consistent values. Every candidate is fitted with the nuisances and the "
                    "parameters of effects already named free beside its own. A parameter fitted within 1 % of either end of its search range "
-                   "(r_A 0.5-2, h0 0.3-1.2, p 0.1-0.8, load exponent 0.4-1.1, shift -30 to +30 K, Z_t/Z_0 0.7-8) is a stand-in and is not named.",
+                   "(r_A 0.5-2, p 0.1-0.8, load exponent 0.4-1.1, shift -30 to +30 K, Z_t/Z_0 0.7-8) is a stand-in and is not named; "
+                   "h0, which no data fix, is asked neither this nor (5).",
                "After each new finding every earlier one must still earn its place: the model is refitted without it, and an effect whose "
                "absence raises the validation error by less than the naming threshold is dropped and not tried again.",
                "The reported gain compares the calibrated baseline and the final model on the test strokes only."};
