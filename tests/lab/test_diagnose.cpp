@@ -370,7 +370,6 @@ TEST(DiagnoseParameters, RulesOneAndFiveIgnoreTheUnidentifiedH0)
     EXPECT_FALSE(diag::pinnedAtEdge(contact, y));
 }
 
-
 // Rule 2's comparisons with the round's other candidates, in their order, with the shares written
 // into the trial.
 TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneAndWithEachOther)
