@@ -174,7 +174,7 @@ std::vector<Candidate> candidates(const EffectModel& m);
 /// True when the fitted parameters put the effect at its own absence.
 bool atNull(const std::string& effect, const std::map<std::string, double>& p);
 /// True when one of the candidate's own identifiable parameters ends within 1 % of its search
-/// range's edge (rule 1: a stand-in pushed past what the candidate can express). h0 is not asked:
+/// range's edge (rule 2's edge condition: a stand-in pushed past what the candidate can express). h0 is not asked:
 /// nothing fixes it, so it ends wherever the search drifted.
 bool pinnedAtEdge(const Candidate& c, const std::vector<double>& x);
 /// Rule 5: refits on the two drive halves agree when neither puts the effect at its absence and

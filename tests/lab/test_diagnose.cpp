@@ -326,10 +326,10 @@ TEST(DiagnoseParameters, ALaterTorsionSearchAlsoStartsWhereRoundOneLeftItsZt)
     EXPECT_FALSE(diag::roundOneStart({trial(1, "hertzian_contact", {{"load_exponent", 0.7}})}, diag::withNuisances(*contact, named)).has_value());
 }
 
-// Rules 1 and 5 judge what the data fix. h0 cancels out of the enhanced law, so its value is
+// Rule 2's edge condition and rule 5 (the drive halves) judge what the data fix. h0 cancels out of the enhanced law, so its value is
 // wherever the search drifted: seed 2049's set 5 (p 0.48) had a rate law 57 % better refused
 // because h0 ended on 1.2.
-TEST(DiagnoseParameters, RulesOneAndFiveIgnoreTheUnidentifiedH0)
+TEST(DiagnoseParameters, TheEdgeAndDriveHalvesRulesIgnoreTheUnidentifiedH0)
 {
     diag::Candidate rate = diag::withNuisances(diag::candidate("rate_dependence", {"h0", "p"}, {0.563, 0.4}), {});
     ASSERT_EQ(rate.scanned, 2u);
