@@ -221,6 +221,24 @@ std::pair<double, double> boundsOf(const std::string& name, const StringInfo& in
     return parameterBounds().at(name);
 }
 
+std::vector<std::pair<std::size_t, int>> gridDimensions(const Candidate& c)
+{
+    // The candidate's own parameters get the resolution their number allows; a further
+    // parameter (gridAlso) only three points, enough to choose the basin COBYLA refines.
+    // h0 cancels out of the error, so points along it would repeat the same errors: it stays
+    // at its start and its share of the grid goes to the parameters the data fix.
+    const std::size_t ns = c.scanned > 0 ? c.scanned : c.names.size();
+    std::vector<std::size_t> own;
+    for (std::size_t k = 0; k < ns; ++k)
+        if (identifiable(c.names[k])) own.push_back(k);
+    const int per = own.size() <= 1 ? 7 : own.size() == 2 ? 5 : 3;
+    std::vector<std::pair<std::size_t, int>> dims;
+    for (const std::size_t k : own) dims.push_back({k, per});
+    if (c.scanned > 0)
+        for (const std::size_t k : c.gridAlso) dims.push_back({k, 3});
+    return dims;
+}
+
 /// Fits the candidate's parameters on the given strokes. The error surface is rough (transients
 /// are chaotic), so a coarse grid over the bounds comes first and COBYLA refines from its best
 /// point on [0, 1]-scaled variables. `scan` = false skips the grid (warm starts).
@@ -239,14 +257,8 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
     std::vector<double> x(n);
     for (std::size_t k = 0; k < n; ++k) x[k] = (start[k] - c.lo[k]) / (c.hi[k] - c.lo[k]);
     if (scan) {
-        // The candidate's own parameters get the resolution their number allows; a further
-        // parameter (gridAlso) only three points, enough to choose the basin COBYLA refines.
-        const std::size_t ns = c.scanned > 0 ? c.scanned : n;
-        const int per = ns == 1 ? 7 : ns == 2 ? 5 : 3;
-        std::vector<std::pair<std::size_t, int>> dims; // (parameter, points)
-        for (std::size_t k = 0; k < ns; ++k) dims.push_back({k, per});
-        if (c.scanned > 0)
-            for (const std::size_t k : c.gridAlso) dims.push_back({k, 3});
+        const auto dims = gridDimensions(c);
+        const int per = dims.empty() ? 7 : dims.front().second;
         int total = 1;
         for (const auto& d : dims) total *= d.second;
         double bestGrid = 1e300;

@@ -182,6 +182,10 @@ bool pinnedAtEdge(const Candidate& c, const std::vector<double>& x);
 /// bootstrap half-width plus a tenth of its search range.
 bool halvesConsistent(const Candidate& c, const std::vector<double>& low, const std::vector<double>& high,
                       const std::map<std::string, double>& bootstrapHalfWidth);
+/// The coarse grid fit() starts from, as (parameter index, points) pairs: 7, 5 or 3 points on
+/// each of the candidate's own identifiable parameters (by their number), 3 on each gridAlso
+/// parameter. h0 gets none: its points would all give the same error.
+std::vector<std::pair<std::size_t, int>> gridDimensions(const Candidate& c);
 /// The model base with the candidate's effects added and its parameters set to x.
 EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x);
 /// Fits the candidate's parameters on the strokes `on`: a coarse grid, then COBYLA from its best point.

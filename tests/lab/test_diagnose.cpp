@@ -370,6 +370,43 @@ TEST(DiagnoseParameters, TheEdgeAndDriveHalvesRulesIgnoreTheUnidentifiedH0)
     EXPECT_FALSE(diag::pinnedAtEdge(contact, y));
 }
 
+// The coarse grid spends its points on what the data fix. h0 cancels out of the enhanced law, so
+// a grid along it repeats each error three times: round 1's 27 points over (r_A, h0, p) were nine
+// distinct ones (seed 2050's set 8 was fitted at p 0.307 for 0.162 from that grid).
+TEST(DiagnoseParameters, TheGridSpansOnlyParametersTheDataFix)
+{
+    using Dims = std::vector<std::pair<std::size_t, int>>;
+    const EffectModel none;
+    const auto first = diag::candidates(none);
+    const auto rate = std::find_if(first.begin(), first.end(), [](const diag::Candidate& c) { return c.effect == "rate_dependence"; });
+    ASSERT_NE(rate, first.end());
+    const diag::Candidate rate1 = diag::withNuisances(*rate, none);
+    ASSERT_EQ(rate1.names[0], "r_A");
+    ASSERT_EQ(rate1.names[1], "h0");
+    ASSERT_EQ(rate1.names[2], "p");
+    EXPECT_EQ(diag::gridDimensions(rate1), (Dims{{0, 5}, {2, 5}})); // 25 points over (r_A, p), h0 at its start
+
+    EffectModel thermal;
+    thermal.effects = {"thermal_memory"};
+    thermal.params = {{"r_A", 1.1}, {"tension_scale", 1.0}, {"beta_scale", 1.0}, {"rod_effusivity_scale", 1.0}};
+    const auto later = diag::candidates(thermal);
+    const auto rate2 = std::find_if(later.begin(), later.end(), [](const diag::Candidate& c) { return c.effect == "rate_dependence"; });
+    ASSERT_NE(rate2, later.end());
+    EXPECT_EQ(diag::gridDimensions(diag::withNuisances(*rate2, thermal)), (Dims{{1, 7}})); // seven over p alone
+    const auto torsion = std::find_if(later.begin(), later.end(), [](const diag::Candidate& c) { return c.effect == "torsional_compliance"; });
+    ASSERT_NE(torsion, later.end());
+    EXPECT_EQ(diag::gridDimensions(diag::withNuisances(*torsion, thermal)), (Dims{{0, 5}, {1, 5}})); // Z_t/Z_0 and r_A
+
+    // Thermal memory alone keeps its three points along the bow side's effusivity (gridAlso).
+    const auto memory = std::find_if(first.begin(), first.end(), [](const diag::Candidate& c) { return c.effect == "thermal_memory"; });
+    ASSERT_NE(memory, first.end());
+    EffectModel calibrated;
+    calibrated.params = {{"tension_scale", 1.0}, {"beta_scale", 1.0}};
+    const diag::Candidate m = diag::withNuisances(*memory, calibrated);
+    ASSERT_EQ(m.gridAlso.size(), 1u);
+    EXPECT_EQ(diag::gridDimensions(m), (Dims{{0, 7}, {m.gridAlso[0], 3}}));
+}
+
 // Rule 2's comparisons with the round's other candidates, in their order, with the shares written
 // into the trial.
 TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneAndWithEachOther)
