@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -37,6 +38,14 @@ struct Case {
     bool gaussian = false;
     bool torsionMayHide = false; ///< the long run: a set with torsion may name less, never more
 };
+
+/// The candidate offered for `effect`, if one is.
+std::optional<diag::Candidate> offered(const std::vector<diag::Candidate>& cands, const std::string& effect)
+{
+    for (const auto& c : cands)
+        if (c.effect == effect) return c;
+    return std::nullopt;
+}
 
 /// A model-made set, written to disk and read back as the CLI would read it.
 MeasurementSet modelSetFromDisk(const SynthSpec& spec, SynthTruth& truth)
@@ -306,8 +315,8 @@ TEST(DiagnoseParameters, ALaterTorsionSearchAlsoStartsWhereRoundOneLeftItsZt)
     named.effects = {"thermal_memory", "rate_dependence"};
     named.params = {{"r_A", 1.25}, {"h0", 0.75}, {"p", 0.68}, {"tension_scale", 0.98}, {"beta_scale", 1.02}, {"rod_effusivity_scale", 1.0}};
     const auto cands = diag::candidates(named);
-    const auto torsion = std::find_if(cands.begin(), cands.end(), [](const diag::Candidate& c) { return c.effect == "torsional_compliance"; });
-    ASSERT_NE(torsion, cands.end());
+    const auto torsion = offered(cands, "torsional_compliance");
+    ASSERT_TRUE(torsion);
     const diag::Candidate c = diag::withNuisances(*torsion, named);
     ASSERT_EQ(c.names.front(), "zt_ratio");
 
@@ -321,8 +330,8 @@ TEST(DiagnoseParameters, ALaterTorsionSearchAlsoStartsWhereRoundOneLeftItsZt)
 
     EXPECT_FALSE(diag::roundOneStart({trial(1, "torsional_compliance", {{"zt_ratio", 7.6}})}, c).has_value()); // round 1 saw no torsion
     EXPECT_FALSE(diag::roundOneStart({trial(2, "torsional_compliance", {{"zt_ratio", 1.2}})}, c).has_value()); // not round 1's
-    const auto contact = std::find_if(cands.begin(), cands.end(), [](const diag::Candidate& x) { return x.effect == "hertzian_contact"; });
-    ASSERT_NE(contact, cands.end());
+    const auto contact = offered(cands, "hertzian_contact");
+    ASSERT_TRUE(contact);
     EXPECT_FALSE(diag::roundOneStart({trial(1, "hertzian_contact", {{"load_exponent", 0.7}})}, diag::withNuisances(*contact, named)).has_value());
 }
 
@@ -378,8 +387,8 @@ TEST(DiagnoseParameters, TheGridSpansOnlyParametersTheDataFix)
     using Dims = std::vector<std::pair<std::size_t, int>>;
     const EffectModel none;
     const auto first = diag::candidates(none);
-    const auto rate = std::find_if(first.begin(), first.end(), [](const diag::Candidate& c) { return c.effect == "rate_dependence"; });
-    ASSERT_NE(rate, first.end());
+    const auto rate = offered(first, "rate_dependence");
+    ASSERT_TRUE(rate);
     const diag::Candidate rate1 = diag::withNuisances(*rate, none);
     ASSERT_EQ(rate1.names[0], "r_A");
     ASSERT_EQ(rate1.names[1], "h0");
@@ -390,16 +399,16 @@ TEST(DiagnoseParameters, TheGridSpansOnlyParametersTheDataFix)
     thermal.effects = {"thermal_memory"};
     thermal.params = {{"r_A", 1.1}, {"tension_scale", 1.0}, {"beta_scale", 1.0}, {"rod_effusivity_scale", 1.0}};
     const auto later = diag::candidates(thermal);
-    const auto rate2 = std::find_if(later.begin(), later.end(), [](const diag::Candidate& c) { return c.effect == "rate_dependence"; });
-    ASSERT_NE(rate2, later.end());
+    const auto rate2 = offered(later, "rate_dependence");
+    ASSERT_TRUE(rate2);
     EXPECT_EQ(diag::gridDimensions(diag::withNuisances(*rate2, thermal)), (Dims{{1, 7}})); // seven over p alone
-    const auto torsion = std::find_if(later.begin(), later.end(), [](const diag::Candidate& c) { return c.effect == "torsional_compliance"; });
-    ASSERT_NE(torsion, later.end());
+    const auto torsion = offered(later, "torsional_compliance");
+    ASSERT_TRUE(torsion);
     EXPECT_EQ(diag::gridDimensions(diag::withNuisances(*torsion, thermal)), (Dims{{0, 5}, {1, 5}})); // Z_t/Z_0 and r_A
 
     // Thermal memory alone keeps its three points along the bow side's effusivity (gridAlso).
-    const auto memory = std::find_if(first.begin(), first.end(), [](const diag::Candidate& c) { return c.effect == "thermal_memory"; });
-    ASSERT_NE(memory, first.end());
+    const auto memory = offered(first, "thermal_memory");
+    ASSERT_TRUE(memory);
     EffectModel calibrated;
     calibrated.params = {{"tension_scale", 1.0}, {"beta_scale", 1.0}};
     const diag::Candidate m = diag::withNuisances(*memory, calibrated);
