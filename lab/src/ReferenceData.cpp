@@ -85,6 +85,7 @@ const std::vector<RigPrior>& referenceRigPriors()
         {"dc_n", -0.3, 0.3, false, "DC offset (N)"},
         {"noise_n", 1e-4, 0.03, true, "white noise, rms (N): clean to poor"},
         {"headroom", 0.3, 1.4, false, "loudest stroke / full scale (V sets): above 1 clips (20 % of sets)"},
+        {"calibration_error", -0.02, 0.02, false, "recorded N / true N - 1: a calibrated sensor's error (N sets only)"},
     };
     return p;
 }
@@ -153,7 +154,15 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     if (has(truth.effects, "torsional_compliance")) draw("zt_ratio");
     // The rig: every value drawn in a fixed order (so a fixed value does not move the others).
     std::map<std::string, double>& rig = truth.rig;
+    // A calibrated sensor's error is drawn from a stream of its own: added after the others,
+    // it leaves every other draw (and so every earlier study's sets) as it was.
+    std::mt19937_64 calibrationRng(spec.seed * 6364136223846793005ull + 1442695040888963407ull);
     for (const RigPrior& p : referenceRigPriors()) {
+        if (p.key == "calibration_error") {
+            const auto it = spec.rig.find(p.key);
+            rig[p.key] = it != spec.rig.end() ? it->second : p.lo + (p.hi - p.lo) * u(calibrationRng);
+            continue;
+        }
         const double x = u(rng), y = u(rng);
         double v = p.logScale ? p.lo * std::pow(p.hi / p.lo, x) : p.lo + (p.hi - p.lo) * x;
         if (p.key == "hum_hz") v = x < 0.2 ? 0.0 : (y < 0.5 ? 50.0 : 60.0);
@@ -357,6 +366,17 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         };
         for (auto& m : set.strokes) scale(m.signal);
         truth.clippedFraction = total ? static_cast<double>(clipped) / static_cast<double>(total) : 0.0;
+        for (auto& rec : set.twoEnded) {
+            scale(rec.bridge);
+            scale(rec.far);
+        }
+    } else {
+        // In newtons the sensor was calibrated, to within its calibration's error.
+        truth.gain = 1.0 + rig["calibration_error"];
+        auto scale = [&](std::vector<double>& x) {
+            for (double& v : x) v *= truth.gain;
+        };
+        for (auto& m : set.strokes) scale(m.signal);
         for (auto& rec : set.twoEnded) {
             scale(rec.bridge);
             scale(rec.far);

@@ -182,6 +182,7 @@ std::vector<StudySet> planStudy(const StudyOptions& o)
 void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<void(const std::string&, double)>& progress)
 {
     const std::vector<StudySet> plan = planStudy(o);
+    if (o.units != "V" && o.units != "N") throw LabError("study --units: '" + o.units + "' is neither V nor N");
     for (const int k : o.only)
         if (k < 0 || k >= static_cast<int>(plan.size()))
             throw LabError("study --only: set " + std::to_string(k) + " is not in a plan of " + std::to_string(plan.size()) + " sets");
@@ -191,6 +192,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     planJson = json{{"grid", o.grid}, {"seed", o.seed}, {"sets", planJson}};
     if (o.gesture != "guettler") planJson["gesture"] = o.gesture; // Guettler studies' plans stay as they were
     if (o.plan != 1) planJson["plan"] = o.plan;                    // and so do version-1 plans
+    if (o.units == "N" && o.gesture != "exp_force") planJson["units"] = "N"; // and volt studies
     if (!o.rig.empty()) planJson["rig"] = o.rig;                   // fixed rig values: part of the study
     // A folder resumes only the study it holds: sets are skipped by folder name, so a different
     // seed, size or grid would silently mix two studies.
@@ -202,7 +204,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
         }
         if (before != planJson)
-            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture, fixed rig values or plan version: "
+            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture, units, fixed rig values or plan version: "
                                                           "a plan.json without \"plan\" is version 1, --plan 1); use a new folder");
     }
     fs::create_directories(dir / "sets");
@@ -242,7 +244,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         spec.oversampling = o.oversampling;
         spec.gesture = o.gesture;
         spec.rig = o.rig;
-        if (o.gesture == "exp_force") spec.units = "N";
+        spec.units = o.gesture == "exp_force" ? "N" : o.units;
         if (!kept) {
             SynthTruth truth;
             say("simulating", 0.0);

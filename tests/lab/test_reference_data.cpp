@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
@@ -91,6 +92,42 @@ TEST(ReferenceSynthData, FixedRigValuesAreKeptAndUnknownOnesRefused)
     spec = small(3);
     spec.oversampling = 2;
     EXPECT_THROW(synthesize(spec, truth), LabError);
+}
+
+// A set in newtons carries its sensor's calibration error, drawn apart from the rest of the rig:
+// fixing or drawing it moves no other value, and a volt set does not use it at all.
+TEST(ReferenceSynthData, ANewtonSetCarriesItsCalibrationErrorAndNothingElseMoves)
+{
+    auto make = [](const std::string& units, std::optional<double> error, SynthTruth& truth) {
+        SynthSpec spec = small(5);
+        spec.units = units;
+        if (error) spec.rig = {{"calibration_error", *error}};
+        return synthesize(spec, truth);
+    };
+    SynthTruth drawn, low, high, voltDrawn, voltFixed;
+    const MeasurementSet n = make("N", std::nullopt, drawn), nLow = make("N", -0.02, low), nHigh = make("N", 0.015, high);
+    const MeasurementSet v = make("V", std::nullopt, voltDrawn), vFixed = make("V", 0.015, voltFixed);
+    const double e = drawn.rig.at("calibration_error");
+    EXPECT_GE(e, -0.02);
+    EXPECT_LE(e, 0.02);
+    EXPECT_NE(e, 0.0);
+    EXPECT_DOUBLE_EQ(drawn.gain, 1.0 + e);
+    EXPECT_DOUBLE_EQ(high.gain, 1.015);
+    for (const auto& [key, value] : drawn.rig) {
+        if (key == "calibration_error") continue;
+        EXPECT_EQ(high.rig.at(key), value) << key << " moved with the calibration error";
+    }
+    // Each newton file is the true force times its gain: the same rig read through two sensors.
+    ASSERT_EQ(nLow.strokes.size(), nHigh.strokes.size());
+    for (std::size_t k = 0; k < nLow.strokes.size(); ++k) {
+        const auto& a = nLow.strokes[k].signal;
+        const auto& b = nHigh.strokes[k].signal;
+        ASSERT_EQ(a.size(), b.size());
+        for (std::size_t i = 0; i < a.size(); i += 97) EXPECT_NEAR(b[i] * 0.98, a[i] * 1.015, 1e-12 * (1.0 + std::abs(a[i]))) << "stroke " << k;
+    }
+    // A volt set's gain comes from its headroom, whatever the calibration error.
+    EXPECT_DOUBLE_EQ(voltDrawn.gain, voltFixed.gain);
+    for (std::size_t k = 0; k < v.strokes.size(); ++k) EXPECT_EQ(v.strokes[k].signal, vFixed.strokes[k].signal);
 }
 
 // --rig-param of synth-data and study: NAME=VALUE, each name one the generator draws and each

@@ -14,6 +14,7 @@
 
 #include "rosin/lab/Diagnose.h"
 #include "rosin/lab/Error.h"
+#include "rosin/lab/Measurement.h"
 #include "rosin/lab/Study.h"
 
 using namespace rosin::lab;
@@ -268,6 +269,43 @@ TEST(Study, AFixedRigValueReachesEverySetAndThePlan)
     }
     EXPECT_EQ(bridges.size(), 2u) << "the values not fixed are drawn per set";
     fs::remove_all(dir);
+}
+
+// --units N: every set is written in newtons through a sensor calibrated to within the rig's
+// calibration error; the plan says so, and a volt study's folder refuses it.
+TEST(Study, ANewtonStudyWritesItsSetsInNewtonsAndItsPlanSaysSo)
+{
+    const fs::path volts = freshDir("units-v"), newtons = freshDir("units-n");
+    StudyOptions o;
+    o.sets = 1;
+    o.nulls = 1;
+    o.grid = 3;
+    o.seed = 13;
+    o.generateOnly = true;
+    runStudy(volts, o);
+    o.units = "N";
+    EXPECT_THROW(runStudy(volts, o), LabError) << "a volt study resumed in newtons";
+    runStudy(newtons, o);
+    json planV, planN;
+    std::ifstream(volts / "plan.json") >> planV;
+    std::ifstream(newtons / "plan.json") >> planN;
+    EXPECT_FALSE(planV.contains("units")) << "volt plans stay as earlier studies wrote them";
+    EXPECT_EQ(planN["units"], "N");
+    json tv, tn;
+    std::ifstream(setDir(volts, 0) / "truth.json") >> tv;
+    std::ifstream(setDir(newtons, 0) / "truth.json") >> tn;
+    EXPECT_EQ(readMeasurementSet(setDir(volts, 0) / "set").units, "V");
+    EXPECT_EQ(readMeasurementSet(setDir(newtons, 0) / "set").units, "N");
+    const double gain = tn["gain_units_per_N"].get<double>();
+    EXPECT_NEAR(gain, 1.0 + tn["rig"]["calibration_error"].get<double>(), 1e-12);
+    EXPECT_LE(std::abs(gain - 1.0), 0.02);
+    EXPECT_GT(std::abs(tv["gain_units_per_N"].get<double>() - 1.0), 0.05) << "a volt set's gain comes from its headroom";
+    EXPECT_EQ(tv["rig"]["bridge_z0y"], tn["rig"]["bridge_z0y"]) << "the same rig, read through another sensor";
+    o.units = "A";
+    EXPECT_THROW(runStudy(freshDir("units-a"), o), LabError);
+    fs::remove_all(volts);
+    fs::remove_all(newtons);
+    fs::remove_all(freshDir("units-a"));
 }
 
 TEST(Study, GenerateOnlyKeepsTheSetsAndALaterRunDiagnosesThem)

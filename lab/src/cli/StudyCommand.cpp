@@ -39,6 +39,10 @@ struct StudyCommand {
             ->capture_default_str();
         cmd->add_option("--gesture", options.gesture, "Strokes of every set: guettler, exp_speed, exp_force or mixed")
             ->check(CLI::IsMember({"guettler", "exp_speed", "exp_force", "mixed"}))->capture_default_str();
+        cmd->add_option("--units", options.units,
+                        "Sensor units of every set: V (an unknown gain, set from the pre-slip ramps) or N (calibrated, within the rig's "
+                        "calibration_error); exp_force sets are always N")
+            ->check(CLI::IsMember({"V", "N"}))->capture_default_str();
         cmd->add_option("--oversampling", options.oversampling, "Reference simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         cmd->add_option("--diagnose-seed", options.diagnose.seed, "Seed of each diagnosis's split and bootstraps")->capture_default_str();
         cmd->add_option("--rig-param", rigValues,

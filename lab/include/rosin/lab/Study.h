@@ -28,6 +28,9 @@ struct StudyOptions {
     /// The sets' strokes (synth-data --gesture): guettler, exp_speed, exp_force (then
     /// calibrated in newtons: rising-force strokes alone cannot set a volt scale) or mixed.
     std::string gesture = "guettler";
+    /// The sensor's units (synth-data --units): V (an unknown gain, which the pre-slip ramps set)
+    /// or N (calibrated, to within the rig's calibration_error). exp_force sets are always N.
+    std::string units = "V";
     /// Rig values fixed in every set instead of drawn (synth-data --rig-param): a study of rigs
     /// that differ from the model in a way no candidate names, such as a strongly stiff string.
     std::map<std::string, double> rig;
