@@ -346,41 +346,33 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         rec.bridge = record(std::move(b), 0, sr);
         rec.far = record(std::move(far), 0, sr);
     });
-    // In volts the recordist set the gain from the loudest stroke; above full scale it clips.
-    truth.gain = 1.0;
-    if (spec.units == "V") {
+    // In volts the recordist set the gain from the loudest stroke, and above full scale the
+    // converter clips; in newtons the sensor was calibrated, to within its calibration's error.
+    const bool volts = spec.units == "V";
+    if (volts) {
         double peak = 0.0;
         for (const auto& m : set.strokes)
             for (double v : m.signal) peak = std::max(peak, std::abs(v));
         truth.gain = rig["headroom"] / peak;
-        std::size_t clipped = 0, total = 0;
-        auto scale = [&](std::vector<double>& x) {
-            for (double& v : x) {
-                v *= truth.gain;
-                if (std::abs(v) >= 0.999) {
-                    v = std::copysign(0.999, v);
-                    ++clipped;
-                }
-                ++total;
-            }
-        };
-        for (auto& m : set.strokes) scale(m.signal);
-        truth.clippedFraction = total ? static_cast<double>(clipped) / static_cast<double>(total) : 0.0;
-        for (auto& rec : set.twoEnded) {
-            scale(rec.bridge);
-            scale(rec.far);
-        }
     } else {
-        // In newtons the sensor was calibrated, to within its calibration's error.
         truth.gain = 1.0 + rig["calibration_error"];
-        auto scale = [&](std::vector<double>& x) {
-            for (double& v : x) v *= truth.gain;
-        };
-        for (auto& m : set.strokes) scale(m.signal);
-        for (auto& rec : set.twoEnded) {
-            scale(rec.bridge);
-            scale(rec.far);
+    }
+    std::size_t clipped = 0, total = 0;
+    auto toSensor = [&](std::vector<double>& x) {
+        for (double& v : x) {
+            v *= truth.gain;
+            if (volts && std::abs(v) >= 0.999) {
+                v = std::copysign(0.999, v);
+                ++clipped;
+            }
+            ++total;
         }
+    };
+    for (auto& m : set.strokes) toSensor(m.signal);
+    truth.clippedFraction = total ? static_cast<double>(clipped) / static_cast<double>(total) : 0.0;
+    for (auto& rec : set.twoEnded) {
+        toSensor(rec.bridge);
+        toSensor(rec.far);
     }
     return set;
 }
