@@ -158,12 +158,8 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     // it leaves every other draw (and so every earlier study's sets) as it was.
     std::mt19937_64 calibrationRng(spec.seed * 6364136223846793005ull + 1442695040888963407ull);
     for (const RigPrior& p : referenceRigPriors()) {
-        if (p.key == "calibration_error") {
-            const auto it = spec.rig.find(p.key);
-            rig[p.key] = it != spec.rig.end() ? it->second : p.lo + (p.hi - p.lo) * u(calibrationRng);
-            continue;
-        }
-        const double x = u(rng), y = u(rng);
+        std::mt19937_64& stream = p.key == "calibration_error" ? calibrationRng : rng;
+        const double x = u(stream), y = u(stream);
         double v = p.logScale ? p.lo * std::pow(p.hi / p.lo, x) : p.lo + (p.hi - p.lo) * x;
         if (p.key == "hum_hz") v = x < 0.2 ? 0.0 : (y < 0.5 ? 50.0 : 60.0);
         if (p.key == "headroom") v = x < 0.2 ? 1.05 + 0.35 * y : 0.3 + 0.6 * y;

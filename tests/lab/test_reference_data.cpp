@@ -105,7 +105,8 @@ TEST(ReferenceSynthData, ANewtonSetCarriesItsCalibrationErrorAndNothingElseMoves
         return synthesize(spec, truth);
     };
     SynthTruth drawn, low, high, voltDrawn, voltFixed;
-    const MeasurementSet n = make("N", std::nullopt, drawn), nLow = make("N", -0.02, low), nHigh = make("N", 0.015, high);
+    make("N", std::nullopt, drawn);
+    const MeasurementSet nLow = make("N", -0.02, low), nHigh = make("N", 0.015, high);
     const MeasurementSet v = make("V", std::nullopt, voltDrawn), vFixed = make("V", 0.015, voltFixed);
     const double e = drawn.rig.at("calibration_error");
     EXPECT_GE(e, -0.02);
