@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 namespace rosin::lab {
@@ -30,23 +31,67 @@ std::vector<double> resample(const std::vector<double>& x, double from, double t
     const double width = half / std::min(1.0, ratio);        // kernel half-width in input samples
     const auto n = static_cast<std::size_t>(std::floor(static_cast<double>(x.size()) * ratio));
     std::vector<double> y(n, 0.0);
-    for (std::size_t i = 0; i < n; ++i) {
-        const double centre = static_cast<double>(i) / ratio;
-        const long lo = static_cast<long>(std::ceil(centre - width)), hi = static_cast<long>(std::floor(centre + width));
-        double acc = 0.0, norm = 0.0;
-        for (long k = lo; k <= hi; ++k) {
-            const double d = static_cast<double>(k) - centre;
+
+    // A kernel is a function of the offsets k - centre alone, and at an integer or simple rate
+    // ratio the same offsets come back sample after sample. Each kernel is computed once (a sine
+    // and a Bessel series per tap were most of a reference set's cost) and reused only where the
+    // offsets match exactly, so the output is the same bit for bit.
+    struct Kernel {
+        std::vector<double> offsets;
+        std::vector<std::size_t> taps; // which offsets fall inside the window
+        std::vector<double> weights;
+        double norm = 0.0;
+    };
+    constexpr std::size_t kKernelsKept = 16;
+    std::vector<Kernel> kept;
+    kept.reserve(kKernelsKept);
+    Kernel scratch;
+    auto build = [&](Kernel& kernel) {
+        kernel.taps.clear();
+        kernel.weights.clear();
+        kernel.norm = 0.0;
+        for (std::size_t j = 0; j < kernel.offsets.size(); ++j) {
+            const double d = kernel.offsets[j];
             const double u = d / width;
             if (std::abs(u) > 1.0) continue;
             const double arg = 2.0 * std::numbers::pi * cutoff * d;
             const double sinc = std::abs(arg) < 1e-12 ? 1.0 : std::sin(arg) / arg;
             const double w = besselI0(beta * std::sqrt(1.0 - u * u)) / i0b;
             const double h = 2.0 * cutoff * sinc * w;
-            norm += h;
+            kernel.norm += h;
+            kernel.taps.push_back(j);
+            kernel.weights.push_back(h);
+        }
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        const double centre = static_cast<double>(i) / ratio;
+        const long lo = static_cast<long>(std::ceil(centre - width)), hi = static_cast<long>(std::floor(centre + width));
+        scratch.offsets.clear();
+        for (long k = lo; k <= hi; ++k) scratch.offsets.push_back(static_cast<double>(k) - centre);
+        const Kernel* kernel = nullptr;
+        for (const Kernel& c : kept)
+            if (c.offsets.size() == scratch.offsets.size() &&
+                std::memcmp(c.offsets.data(), scratch.offsets.data(), c.offsets.size() * sizeof(double)) == 0) {
+                kernel = &c;
+                break;
+            }
+        if (!kernel) {
+            build(scratch);
+            if (kept.size() < kKernelsKept) {
+                kept.push_back(scratch);
+                kernel = &kept.back();
+            } else {
+                kernel = &scratch;
+            }
+        }
+        double acc = 0.0;
+        for (std::size_t t = 0; t < kernel->taps.size(); ++t) {
+            const long k = lo + static_cast<long>(kernel->taps[t]);
+            const double h = kernel->weights[t];
             if (k >= 0 && k < static_cast<long>(x.size())) acc += h * x[static_cast<std::size_t>(k)];
             else acc += h * (k < 0 ? x.front() : x.back()); // hold the ends: no edge ringing
         }
-        y[i] = norm != 0.0 ? acc / norm : 0.0;
+        y[i] = kernel->norm != 0.0 ? acc / kernel->norm : 0.0;
     }
     return y;
 }

@@ -98,6 +98,36 @@ TEST(Resample, KeepsTheBandAndRemovesWhatWouldAlias)
     EXPECT_LT(peakHf, 1e-3); // 30 kHz would fold to 14.1 kHz: removed (< -60 dB)
 }
 
+// resample reuses a kernel wherever the offsets to the input samples repeat (at an integer ratio,
+// every output sample). Each output must still be the Kaiser-windowed sinc sum written out here,
+// at the ends (where input samples are held) and in the middle, whether its kernel was reused
+// (4:1 and 1:3) or made afresh (48 to 44.1 kHz, where no two samples share offsets).
+TEST(Resample, EveryOutputIsTheWindowedSincSumWhetherItsKernelIsReusedOrNot)
+{
+    std::vector<double> x(4000);
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::sin(0.013 * i * i / 100.0) + 0.3 * std::cos(0.21 * i);
+    auto i0 = [](double v) {
+        double sum = 1, term = 1;
+        for (int k = 1; k < 200; ++k) sum += term *= (v / (2.0 * k)) * (v / (2.0 * k));
+        return sum;
+    };
+    for (const auto& [from, to] : std::vector<std::pair<double, double>>{{192000, 48000}, {48000, 144000}, {48000, 44100}}) {
+        const std::vector<double> y = resample(x, from, to);
+        const double ratio = to / from, cutoff = 0.45 * std::min(from, to) / from, width = 32 / std::min(1.0, ratio);
+        for (const std::size_t i : {std::size_t{0}, std::size_t{3}, y.size() / 2, y.size() / 2 + 1, y.size() - 1}) {
+            const double centre = static_cast<double>(i) / ratio;
+            double acc = 0, norm = 0;
+            for (long k = static_cast<long>(std::ceil(centre - width)); k <= static_cast<long>(std::floor(centre + width)); ++k) {
+                const double d = static_cast<double>(k) - centre, u = d / width, arg = 2 * M_PI * cutoff * d;
+                const double h = 2 * cutoff * (std::abs(arg) < 1e-12 ? 1.0 : std::sin(arg) / arg) * i0(8 * std::sqrt(std::max(0.0, 1 - u * u))) / i0(8);
+                norm += h;
+                acc += h * x[static_cast<std::size_t>(std::clamp<long>(k, 0, static_cast<long>(x.size()) - 1))];
+            }
+            EXPECT_NEAR(y[i], acc / norm, 1e-12) << from << " to " << to << " Hz, output " << i;
+        }
+    }
+}
+
 TEST(MeasurementSet, SyntheticSetRoundTripsAndItsArtefactsAreUndone)
 {
     const fs::path d = freshDir("roundtrip");
