@@ -12,21 +12,37 @@ seconds=${1:-20}
 out=$(realpath -m "${2:-build/fuzz}")
 runs=${3:--1}
 mkdir -p "$out"
-flags=(-std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined)
+# Line tables are all a crash report needs (full debug info costs a fifth more compile time).
+flags=(-std=c++20 -O1 -gline-tables-only -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined)
+objflags=(-std=c++20 -O1 -gline-tables-only -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined)
 inc=(-I plugin/hid/include -I plugin/rt/include -I presets/lib/include -I plugin/engine/include -I dsp/include -I plugin/src)
-hid_src=(plugin/hid/src/Descriptor.cpp plugin/hid/src/Mapping.cpp plugin/hid/src/Devices.cpp presets/lib/src/Document.cpp)
-
-clang++ "${flags[@]}" "${inc[@]}" plugin/fuzz/FuzzHid.cpp "${hid_src[@]}" -o "$out/fuzz-hid"
-clang++ "${flags[@]}" "${inc[@]}" plugin/fuzz/FuzzMappingJson.cpp "${hid_src[@]}" -o "$out/fuzz-mapping"
-# juce_core once per build folder (about 40 s); the state reader needs nothing else of JUCE.
 juce=/usr/share/juce/modules
+juce_defs=(-DJUCE_GLOBAL_MODULE_SETTINGS_INCLUDED=1 -DJUCE_STANDALONE_APPLICATION=1 -DNDEBUG=1 -I "$juce")
+
+# Each of our sources compiled once per run and linked into every target that needs it (the HID
+# sources go into all three).
+object() { # object SOURCE [extra flags...] -> prints the object's path
+  local src=$1; shift
+  local obj="$out/obj/${src//\//_}.o"
+  mkdir -p "$out/obj"
+  clang++ "${objflags[@]}" "${inc[@]}" "$@" -c "$src" -o "$obj"
+  echo "$obj"
+}
+hid_obj=()
+for src in plugin/hid/src/Descriptor.cpp plugin/hid/src/Mapping.cpp plugin/hid/src/Devices.cpp presets/lib/src/Document.cpp; do
+  hid_obj+=("$(object "$src")")
+done
+clang++ "${flags[@]}" "$(object plugin/fuzz/FuzzHid.cpp)" "${hid_obj[@]}" -o "$out/fuzz-hid"
+clang++ "${flags[@]}" "$(object plugin/fuzz/FuzzMappingJson.cpp)" "${hid_obj[@]}" -o "$out/fuzz-mapping"
+# The state reader needs juce_core and nothing else of JUCE (its object takes longest to build).
 if [[ ! -f "$out/juce_core.o" || "$juce/juce_core/juce_core.cpp" -nt "$out/juce_core.o" ]]; then
-  clang++ -std=c++20 -O1 -g -fsanitize=fuzzer-no-link,address,undefined -DJUCE_GLOBAL_MODULE_SETTINGS_INCLUDED=1 \
-    -DJUCE_STANDALONE_APPLICATION=1 -DJUCE_USE_CURL=0 -DNDEBUG=1 -I "$juce" -c "$juce/juce_core/juce_core.cpp" -o "$out/juce_core.o"
+  clang++ "${objflags[@]}" "${juce_defs[@]}" -DJUCE_USE_CURL=0 -c "$juce/juce_core/juce_core.cpp" -o "$out/juce_core.o"
 fi
-clang++ "${flags[@]}" "${inc[@]}" -DJUCE_GLOBAL_MODULE_SETTINGS_INCLUDED=1 -DJUCE_STANDALONE_APPLICATION=1 -DNDEBUG=1 -I "$juce" \
-  plugin/fuzz/FuzzState.cpp plugin/src/StateFormat.cpp plugin/engine/src/Parameters.cpp "${hid_src[@]}" "$out/juce_core.o" \
-  -lz -lpthread -ldl -o "$out/fuzz-state"
+state_obj=()
+for src in plugin/fuzz/FuzzState.cpp plugin/src/StateFormat.cpp plugin/engine/src/Parameters.cpp; do
+  state_obj+=("$(object "$src" "${juce_defs[@]}")")
+done
+clang++ "${flags[@]}" "${state_obj[@]}" "${hid_obj[@]}" "$out/juce_core.o" -lz -lpthread -ldl -o "$out/fuzz-state"
 
 # Seeds: every real descriptor (with each device choice), the shipped controller maps, and the
 # saved states kept under tests/data/state (their inner XML).
