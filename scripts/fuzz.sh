@@ -7,6 +7,7 @@
 # CI runs 20 s per target (ctest hid_fuzz_bounded); the long run (ctest label long,
 # hid_fuzz_long) asks for 10^6 executions of each. Exit status: non-zero on any crash.
 set -euo pipefail
+shopt -s inherit_errexit # a failed compile inside $(object ...) stops the script too
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
 out=$(realpath -m "${2:-build/fuzz}")
@@ -32,8 +33,10 @@ hid_obj=()
 for src in plugin/hid/src/Descriptor.cpp plugin/hid/src/Mapping.cpp plugin/hid/src/Devices.cpp presets/lib/src/Document.cpp; do
   hid_obj+=("$(object "$src")")
 done
-clang++ "${flags[@]}" "$(object plugin/fuzz/FuzzHid.cpp)" "${hid_obj[@]}" -o "$out/fuzz-hid"
-clang++ "${flags[@]}" "$(object plugin/fuzz/FuzzMappingJson.cpp)" "${hid_obj[@]}" -o "$out/fuzz-mapping"
+hid_main=$(object plugin/fuzz/FuzzHid.cpp)
+mapping_main=$(object plugin/fuzz/FuzzMappingJson.cpp)
+clang++ "${flags[@]}" "$hid_main" "${hid_obj[@]}" -o "$out/fuzz-hid"
+clang++ "${flags[@]}" "$mapping_main" "${hid_obj[@]}" -o "$out/fuzz-mapping"
 # The state reader needs juce_core and nothing else of JUCE (its object takes longest to build).
 if [[ ! -f "$out/juce_core.o" || "$juce/juce_core/juce_core.cpp" -nt "$out/juce_core.o" ]]; then
   clang++ "${objflags[@]}" "${juce_defs[@]}" -DJUCE_USE_CURL=0 -c "$juce/juce_core/juce_core.cpp" -o "$out/juce_core.o"
