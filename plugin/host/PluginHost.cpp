@@ -253,6 +253,12 @@ void PluginHost::stopStream() { impl_->plugin->releaseResources(); }
 
 int PluginHost::parameterCount() const { return impl_->plugin->getParameters().size(); }
 
+int PluginHost::bypassParameterIndex() const
+{
+    auto* bypass = impl_->plugin->getBypassParameter();
+    return bypass != nullptr ? impl_->plugin->getParameters().indexOf(bypass) : -1;
+}
+
 void PluginHost::setParameterNormalised(int index, float value)
 {
     const auto& params = impl_->plugin->getParameters();

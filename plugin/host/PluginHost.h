@@ -96,6 +96,8 @@ public:
     /// [any thread] A parameter by its index in parameters(), normalised: a host's automation thread.
     void setParameterNormalised(int index, float value);
     int parameterCount() const;
+    /// The index of the host's bypass parameter (normalised 1 = bypassed), or -1 when it has none.
+    int bypassParameterIndex() const;
 
     /// Times processBlock as a DAW would call it (real-time mode): `midi` is sent in the first
     /// block, `warmup` seconds run untimed, then `reps` passes of `seconds` each are timed.

@@ -181,12 +181,17 @@ int validate(const std::filesystem::path& plugin, const ValidateOptions& o, std:
             std::atomic<bool> done{false};
             std::atomic<long> moves{0};
             const int count = h.parameterCount();
+            // The host's bypass stays out of the walk (check 5 plays it on its own): at 0.5 +- a
+            // step it bypassed Rosin for about half of a VST3 walk and, as LV2's first parameter,
+            // for the whole LV2 walk, which then heard nothing of what the parameters did.
+            const int bypass = h.bypassParameterIndex();
             std::thread automation([&] {
                 std::mt19937 rng(o.seed);
                 std::uniform_real_distribution<float> step(-0.08f, 0.08f);
                 std::vector<float> value(static_cast<std::size_t>(count), 0.5f);
                 while (!done.load()) {
                     for (int p = 0; p < count; ++p) {
+                        if (p == bypass) continue;
                         float& v = value[static_cast<std::size_t>(p)];
                         v = std::clamp(v + step(rng), 0.0f, 1.0f);
                         h.setParameterNormalised(p, v);
@@ -210,7 +215,8 @@ int validate(const std::filesystem::path& plugin, const ValidateOptions& o, std:
             play(h, 48000.0, 128, 0.01, false, s, nullptr);
             h.stopStream();
             const audit::Counts c = audit::read();
-            check.report(s.nonFinite == 0 && s.peak <= outputBound && c.plugin.total() == 0, "parameters random-walked from another thread",
+            // The walk must be heard: a peak this low means the notes never sounded (bypassed, muted).
+            check.report(s.nonFinite == 0 && s.peak <= outputBound && s.peak > 1e-3 && c.plugin.total() == 0, "parameters random-walked from another thread",
                          std::to_string(moves.load()) + " moves over " + number(o.walkSeconds) + " s: non-finite " + std::to_string(s.nonFinite) +
                              ", peak " + number(s.peak) + "; in processBlock " + tally(c.plugin));
         }
@@ -244,7 +250,32 @@ int validate(const std::filesystem::path& plugin, const ValidateOptions& o, std:
                      "rms after the restore " + number(tail.rms()) + (same ? ", the state reads back the same" : ", the state changed on the way"));
     }
 
-    // 5. Bus layouts: mono and stereo outputs.
+    // 5. The host's bypass in the middle of a note: Rosin fades out, keeps following the keys
+    //    while bypassed (a note released then does not sound on when the bypass ends; with
+    //    JUCE's default bypass it did, for ever) and plays the next note after.
+    if (const int bypass = h.bypassParameterIndex(); bypass < 0) {
+        check.report(false, "host bypass mid-note", "the host shows no bypass parameter");
+    } else {
+        h.startStream(48000.0, 256, true, 2);
+        Signal before, fade, bypassed, after, tail, next;
+        play(h, 48000.0, 256, 0.5, false, before, [](long long i, int) { return i == 0 ? Midi{{0, bytes({0x9B, 45, 100})}} : Midi{}; });
+        h.setParameterNormalised(bypass, 1.0f);
+        play(h, 48000.0, 256, 0.03, false, fade, nullptr); // the block the change lands in, then the 10 ms fade
+        play(h, 48000.0, 256, 0.3, false, bypassed, [](long long i, int) { return i == 10 ? Midi{{0, bytes({0x8B, 45, 0})}} : Midi{}; });
+        h.setParameterNormalised(bypass, 0.0f);
+        play(h, 48000.0, 256, 1.5, false, after, nullptr); // the released string rings down
+        play(h, 48000.0, 256, 0.5, false, tail, nullptr);
+        play(h, 48000.0, 256, 0.3, false, next, [](long long i, int) { return i == 0 ? Midi{{0, bytes({0x9B, 52, 100})}} : Midi{}; });
+        h.stopStream();
+        const long long nonFinite = before.nonFinite + fade.nonFinite + bypassed.nonFinite + after.nonFinite + tail.nonFinite + next.nonFinite;
+        check.report(before.rms() > 1e-2 && bypassed.peak == 0.0 && tail.rms() < 1e-3 && next.rms() > 1e-2 && nonFinite == 0,
+                     "host bypass mid-note",
+                     "rms before " + number(before.rms()) + ", peak while bypassed " + number(bypassed.peak) +
+                         ", rms of a note released while bypassed, 1.5 s after the bypass ends " + number(tail.rms()) +
+                         ", rms of the next note " + number(next.rms()));
+    }
+
+    // 6. Bus layouts: mono and stereo outputs.
     for (int channels : {1, 2}) {
         const std::string name = channels == 1 ? "mono output" : "stereo output";
         try {
@@ -272,7 +303,7 @@ int validate(const std::filesystem::path& plugin, const ValidateOptions& o, std:
         }
     }
 
-    // 6. Offline: an instrument change lands on the block it is asked for, and output stays finite.
+    // 7. Offline: an instrument change lands on the block it is asked for, and output stays finite.
     {
         h.startStream(48000.0, 512, false, 2);
         Signal s;
@@ -284,7 +315,7 @@ int validate(const std::filesystem::path& plugin, const ValidateOptions& o, std:
         check.report(s.nonFinite == 0 && s.rms() > 1e-3 && landed, "offline rendering", "rms " + number(s.rms()) + (landed ? "" : ", the instrument did not change"));
     }
 
-    // 7. After the notes end, silence in gives silence out, with no denormals.
+    // 8. After the notes end, silence in gives silence out, with no denormals.
     {
         h.startStream(44100.0, 512, true, 2);
         Signal notes, quiet;

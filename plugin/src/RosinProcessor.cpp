@@ -410,7 +410,11 @@ void RosinProcessor::renderCurrent(float* left, float* right, int from, int to) 
     }
 }
 
-void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBuffer& midi)
+void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBuffer& midi) { process(buffer, midi, false); }
+
+void RosinProcessor::processBlockBypassed(juce::AudioBuffer<float>& buffer, juce::MidiBuffer& midi) { process(buffer, midi, true); }
+
+void RosinProcessor::process(juce::AudioBuffer<float>& buffer, juce::MidiBuffer& midi, bool bypassed)
 {
     if (rosin_audit_scope) rosin_audit_scope(1);
     juce::ScopedNoDenormals noDenormals;
@@ -473,6 +477,18 @@ void RosinProcessor::processBlock(juce::AudioBuffer<float>& buffer, juce::MidiBu
     }
     if (retiring_ != nullptr && retiringLeft_ <= 0 && engines_.retire(retiring_)) retiring_ = nullptr;
     lastBlockStart_ = blockStart;
+
+    // The host's bypass: the engine above went on following the keys; only its output fades.
+    const float target = bypassed ? 0.0f : 1.0f;
+    if (outputGain_ == 0.0f && target == 0.0f) {
+        buffer.clear();
+    } else if (outputGain_ != target) {
+        const float step = 1.0f / static_cast<float>(fadeLength_);
+        for (int i = 0; i < n; ++i) {
+            outputGain_ = target > outputGain_ ? std::min(target, outputGain_ + step) : std::max(target, outputGain_ - step);
+            for (int ch = 0; ch < std::min(2, buffer.getNumChannels()); ++ch) buffer.getWritePointer(ch)[i] *= outputGain_;
+        }
+    }
 
     if (rosin_audit_scope) rosin_audit_scope(0);
 }

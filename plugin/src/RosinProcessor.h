@@ -48,6 +48,11 @@ public:
     bool isBusesLayoutSupported(const BusesLayout& layouts) const override;
     void processBlock(juce::AudioBuffer<float>&, juce::MidiBuffer&) override;
     using AudioProcessor::processBlock;
+    /// The host's bypass. JUCE's default drops the MIDI, so a note released while bypassed
+    /// sounded on for ever once the bypass ended; Rosin keeps following the keys and fades its
+    /// output out (and in again after) over swapFadeSeconds, at the cost of its CPU while bypassed.
+    void processBlockBypassed(juce::AudioBuffer<float>&, juce::MidiBuffer&) override;
+    using AudioProcessor::processBlockBypassed;
 
     juce::AudioProcessorEditor* createEditor() override;
     bool hasEditor() const override { return true; }
@@ -119,6 +124,7 @@ private:
     void housekeeping(); ///< [loader thread] free retired objects, move host parameters, record learns
     void pollHid();      ///< [loader thread] start or stop the HID input with its parameter
     void swapEngine() noexcept;
+    void process(juce::AudioBuffer<float>& buffer, juce::MidiBuffer& midi, bool bypassed);
     void gatherEvents(const juce::MidiBuffer& midi, int numSamples) noexcept;
     void hidEvents(int numSamples) noexcept;
     void renderCurrent(float* left, float* right, int from, int to) noexcept;
@@ -143,6 +149,7 @@ private:
     engine::Synth* current_ = nullptr;
     engine::Synth* retiring_ = nullptr;
     int retiringLeft_ = 0, fadeLength_ = 480;
+    float outputGain_ = 1.0f; ///< 0 while the host bypasses Rosin, ramped over fadeLength_ either way
     juce::AudioBuffer<float> fadeBuffer_;
     engine::Performance performance_;
     engine::MidiDecoder decoder_;

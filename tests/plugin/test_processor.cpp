@@ -560,3 +560,63 @@ TEST(ProcessorThreads, StatesMapsLearnAndEnginesChangeWhileAudioRuns)
     EXPECT_GT(blocksDone.load(), 100);
     EXPECT_GT(p.enginesInstalled(), 5);
 }
+
+namespace {
+/// Blocks as a host plays them while it bypasses the plugin (JUCE calls processBlockBypassed).
+double bypassedRms(RosinProcessor& p, int count, juce::MidiBuffer midi = {}, float* firstHalfRms = nullptr)
+{
+    juce::AudioBuffer<float> buffer(2, 256);
+    double sum = 0.0;
+    for (int b = 0; b < count; ++b) {
+        buffer.clear();
+        p.processBlockBypassed(buffer, midi);
+        midi.clear();
+        double half = 0.0;
+        for (int i = 0; i < 256; ++i) {
+            const double x = buffer.getSample(0, i);
+            sum += x * x;
+            if (i < 128) half += x * x;
+        }
+        if (b == 0 && firstHalfRms) *firstHalfRms = static_cast<float>(std::sqrt(half / 128.0));
+    }
+    return std::sqrt(sum / (count * 256.0));
+}
+
+double playedRms(RosinProcessor& p, int count, juce::MidiBuffer midi = {})
+{
+    juce::AudioBuffer<float> buffer(2, 256);
+    double sum = 0.0;
+    for (int b = 0; b < count; ++b) {
+        buffer.clear();
+        p.processBlock(buffer, midi);
+        midi.clear();
+        for (int i = 0; i < 256; ++i) sum += buffer.getSample(0, i) * buffer.getSample(0, i);
+    }
+    return std::sqrt(sum / (count * 256.0));
+}
+} // namespace
+
+// JUCE's default bypass drops the MIDI: a note released while the host bypassed Rosin sounded at
+// full level for ever once the bypass ended (rms 0.13 in the headless host, both formats).
+TEST(ProcessorBypass, ANoteReleasedWhileBypassedDoesNotSoundWhenTheBypassEnds)
+{
+    juce::ScopedJuceInitialiser_GUI juce;
+    RosinProcessor p;
+    p.setPlayConfigDetails(0, 2, 48000.0, 256);
+    p.prepareToPlay(48000.0, 256);
+    p.setNonRealtime(true);
+    const double playing = playedRms(p, 80, messages({juce::MidiMessage::noteOn(1, 45, 0.8f)}));
+    ASSERT_GT(playing, 0.02);
+    // The first bypassed block fades (10 ms = 480 samples) rather than cuts; then silence.
+    float fadeStart = 0.0f;
+    bypassedRms(p, 2, {}, &fadeStart);
+    EXPECT_GT(fadeStart, 0.2 * playing);
+    EXPECT_EQ(bypassedRms(p, 20, messages({juce::MidiMessage::noteOff(1, 45)})), 0.0);
+    // Bypass off: the string was released while bypassed, so it has rung down (0.5 s after).
+    playedRms(p, 94);
+    EXPECT_LT(playedRms(p, 47), 1e-3);
+    // A note held through the bypass plays on after it, and the next note plays.
+    EXPECT_GT(playedRms(p, 80, messages({juce::MidiMessage::noteOn(1, 50, 0.8f)})), 0.02);
+    bypassedRms(p, 40);
+    EXPECT_GT(playedRms(p, 40), 0.02);
+}
