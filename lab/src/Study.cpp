@@ -62,6 +62,7 @@ const std::map<std::string, Tolerance>& tolerances()
 
 struct Scored {
     int index = 0;
+    std::string study; ///< the study folder's name, when several studies are scored together
     std::uint64_t seed = 0;
     std::vector<std::string> hidden, found;
     std::map<std::string, double> truth;
@@ -73,6 +74,7 @@ struct Scored {
     std::map<std::string, std::array<double, 2>> statistical, withRig;
     std::set<std::string> unidentified; ///< reported as not identified: interval = search range
     std::map<std::string, std::array<double, 3>> calibration; ///< nuisance -> value, ci low, ci high
+    std::map<std::string, std::array<double, 2>> calibrationCurvature; ///< nuisance -> its curvature interval alone, where given
     std::map<std::string, double> rig;
     double baseline = 0, final = 0;
     bool unexplained = false;
@@ -266,64 +268,119 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     mpi.barrier();
 }
 
-std::string scoreStudy(const fs::path& dir)
+namespace {
+json readPlan(const fs::path& dir)
 {
+    json plan;
+    if (fs::exists(dir / "plan.json")) {
+        try {
+            std::ifstream(dir / "plan.json") >> plan;
+        } catch (const json::exception& e) {
+            throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
+        }
+    }
+    return plan;
+}
+
+/// What must match for studies to be scored as one: the strokes and the rig population. The seed,
+/// the number of sets and the plan version may differ (a plan of either version draws its sets
+/// from the same population of rigs and effects).
+json populationOf(const json& plan)
+{
+    json p;
+    for (const char* key : {"grid", "gesture", "units", "rig"})
+        if (plan.contains(key)) p[key] = plan[key];
+    return p;
+}
+} // namespace
+
+std::string scoreStudy(const fs::path& dir) { return scoreStudies(dir, {dir}); }
+
+std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studies)
+{
+    if (studies.empty()) throw LabError("study --pool: no study folders given");
+    const bool pooled = studies.size() > 1 || (fs::exists(dir) && !fs::equivalent(dir, studies.front()));
+    json plan = readPlan(studies.front());
+    std::map<std::uint64_t, std::string> seenSeeds; // set seed -> where it was first met
+    std::string sources;
     std::vector<Scored> sets;
-    if (!fs::is_directory(dir / "sets")) throw LabError(dir.string() + ": no sets/ folder (run the study first)");
-    std::vector<fs::path> folders;
-    for (const auto& e : fs::directory_iterator(dir / "sets")) folders.push_back(e.path());
-    std::sort(folders.begin(), folders.end());
-    for (const fs::path& f : folders) {
-        if (!fs::exists(f / "diagnosis" / "diagnosis.json") || !fs::exists(f / "truth.json")) continue;
-        json t, d;
-        std::ifstream(f / "truth.json") >> t;
-        std::ifstream(f / "diagnosis" / "diagnosis.json") >> d;
-        Scored s;
-        s.index = std::stoi(f.filename().string());
-        s.seed = t.value("seed", 0ull);
-        s.hidden = t["effects"].get<std::vector<std::string>>();
-        s.truth = t["params"].get<std::map<std::string, double>>();
-        if (t.contains("rig")) s.rig = t["rig"].get<std::map<std::string, double>>();
-        // The sensor's true scale is the inverse of the gain the generator applied.
-        if (t.contains("gain_units_per_N") && t["gain_units_per_N"].get<double>() > 0.0)
-            s.rig["scale_n_per_unit"] = 1.0 / t["gain_units_per_N"].get<double>();
-        for (const auto& finding : d["findings"]) {
-            const std::string e = finding["effect"].get<std::string>();
-            if (e == "none") continue;
-            s.found.push_back(e);
-            for (const auto& [name, v] : finding["parameters"].items()) {
-                s.estimate[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
-                if (v.contains("identified") && !v["identified"].get<bool>()) s.unidentified.insert(name);
-                if (v.contains("ci95_bootstrap")) {
-                    std::array<double, 2> w{v["ci95_bootstrap"][0].get<double>(), v["ci95_bootstrap"][1].get<double>()};
-                    if (v.contains("ci95_curvature"))
-                        w = {std::min(w[0], v["ci95_curvature"][0].get<double>()), std::max(w[1], v["ci95_curvature"][1].get<double>())};
-                    s.withoutHalves[name] = w;
-                }
-                if (v.contains("ci95_statistical")) {
-                    const double x = v["value"].get<double>(), lo = v["ci95_statistical"][0].get<double>(), hi = v["ci95_statistical"][1].get<double>();
-                    s.statistical[name] = {lo, hi};
-                    const double down = v.contains("systematic_moves") ? v["systematic_moves"][0].get<double>() : 0.0;
-                    const double up = v.contains("systematic_moves") ? v["systematic_moves"][1].get<double>() : 0.0;
-                    const auto [rigLo, rigHi] = widenedInQuadrature(x, {lo, hi}, down, up);
-                    s.withRig[name] = {rigLo, rigHi};
+    for (const fs::path& study : studies) {
+        if (!fs::is_directory(study / "sets")) throw LabError(study.string() + ": no sets/ folder (run the study first)");
+        if (pooled && fs::exists(dir) && fs::equivalent(dir, study))
+            throw LabError(dir.string() + ": the pooled summary would overwrite the summary of a study it pools; write it to another folder");
+        const json here = readPlan(study);
+        if (populationOf(here) != populationOf(plan))
+            throw LabError(study.string() + "/plan.json: " + populationOf(here).dump() + " where " + studies.front().string() + " has " +
+                           populationOf(plan).dump() + ": studies scored together must share the grid, gesture, units and fixed rig values");
+        const std::size_t before = sets.size();
+        std::vector<fs::path> folders;
+        for (const auto& e : fs::directory_iterator(study / "sets")) folders.push_back(e.path());
+        std::sort(folders.begin(), folders.end());
+        for (const fs::path& f : folders) {
+            if (!fs::exists(f / "diagnosis" / "diagnosis.json") || !fs::exists(f / "truth.json")) continue;
+            json t, d;
+            std::ifstream(f / "truth.json") >> t;
+            std::ifstream(f / "diagnosis" / "diagnosis.json") >> d;
+            Scored s;
+            s.index = std::stoi(f.filename().string());
+            s.seed = t.value("seed", 0ull);
+            s.hidden = t["effects"].get<std::vector<std::string>>();
+            s.truth = t["params"].get<std::map<std::string, double>>();
+            if (t.contains("rig")) s.rig = t["rig"].get<std::map<std::string, double>>();
+            // The sensor's true scale is the inverse of the gain the generator applied.
+            if (t.contains("gain_units_per_N") && t["gain_units_per_N"].get<double>() > 0.0)
+                s.rig["scale_n_per_unit"] = 1.0 / t["gain_units_per_N"].get<double>();
+            for (const auto& finding : d["findings"]) {
+                const std::string e = finding["effect"].get<std::string>();
+                if (e == "none") continue;
+                s.found.push_back(e);
+                for (const auto& [name, v] : finding["parameters"].items()) {
+                    s.estimate[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
+                    if (v.contains("identified") && !v["identified"].get<bool>()) s.unidentified.insert(name);
+                    if (v.contains("ci95_bootstrap")) {
+                        std::array<double, 2> w{v["ci95_bootstrap"][0].get<double>(), v["ci95_bootstrap"][1].get<double>()};
+                        if (v.contains("ci95_curvature"))
+                            w = {std::min(w[0], v["ci95_curvature"][0].get<double>()), std::max(w[1], v["ci95_curvature"][1].get<double>())};
+                        s.withoutHalves[name] = w;
+                    }
+                    if (v.contains("ci95_statistical")) {
+                        const double x = v["value"].get<double>(), lo = v["ci95_statistical"][0].get<double>(), hi = v["ci95_statistical"][1].get<double>();
+                        s.statistical[name] = {lo, hi};
+                        const double down = v.contains("systematic_moves") ? v["systematic_moves"][0].get<double>() : 0.0;
+                        const double up = v.contains("systematic_moves") ? v["systematic_moves"][1].get<double>() : 0.0;
+                        const auto [rigLo, rigHi] = widenedInQuadrature(x, {lo, hi}, down, up);
+                        s.withRig[name] = {rigLo, rigHi};
+                    }
                 }
             }
+            if (d.contains("calibration") && d["calibration"].contains("values"))
+                for (const auto& [name, v] : d["calibration"]["values"].items())
+                    if (v["value"].is_number() && v["ci95"].size() == 2) {
+                        s.calibration[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
+                        if (v.contains("ci95_curvature") && v["ci95_curvature"].size() == 2)
+                            s.calibrationCurvature[name] = {v["ci95_curvature"][0].get<double>(), v["ci95_curvature"][1].get<double>()};
+                    }
+            s.baseline = d["gain"]["baseline"].get<double>();
+            s.final = d["gain"]["final"].get<double>();
+            s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
+            if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
+            s.beyondUsual = s.unexplained && d["unexplained_residual"].value("beyond_usual", false);
+            if (s.unexplained && d["unexplained_residual"].contains("stand_ins"))
+                for (const auto& standIn : d["unexplained_residual"]["stand_ins"]) s.standIns.push_back(standIn["effect"].get<std::string>());
+            if (pooled) s.study = study.filename().string();
+            // The same set counted twice (one study pooled twice, or two folders of one seed) would
+            // pass for a larger study.
+            if (const auto [at, fresh] = seenSeeds.emplace(s.seed, f.string()); !fresh && s.seed != 0)
+                throw LabError(f.string() + ": set seed " + std::to_string(s.seed) + " was already scored from " + at->second);
+            sets.push_back(std::move(s));
         }
-        if (d.contains("calibration") && d["calibration"].contains("values"))
-            for (const auto& [name, v] : d["calibration"]["values"].items())
-                if (v["value"].is_number() && v["ci95"].size() == 2)
-                    s.calibration[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
-        s.baseline = d["gain"]["baseline"].get<double>();
-        s.final = d["gain"]["final"].get<double>();
-        s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
-        if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
-        s.beyondUsual = s.unexplained && d["unexplained_residual"].value("beyond_usual", false);
-        if (s.unexplained && d["unexplained_residual"].contains("stand_ins"))
-            for (const auto& standIn : d["unexplained_residual"]["stand_ins"]) s.standIns.push_back(standIn["effect"].get<std::string>());
-        sets.push_back(std::move(s));
+        if (pooled)
+            sources += (sources.empty() ? "" : ", ") + study.filename().string() +
+                       (here.contains("seed") ? " (seed " + std::to_string(here["seed"].get<std::uint64_t>()) + ", " : " (") +
+                       std::to_string(sets.size() - before) + " sets)";
     }
     if (sets.empty()) throw LabError(dir.string() + ": no diagnosed sets to score");
+    fs::create_directories(dir);
 
     std::ostringstream md;
     int nNull = 0, nullFp = 0, exact = 0;
@@ -339,6 +396,7 @@ std::string scoreStudy(const fs::path& dir)
     }
     json summary;
     md << "# Diagnosis study: " << sets.size() << " reference sets\n\n";
+    if (pooled) md << "Scored together from " << studies.size() << " studies: " << sources << ".\n\n";
     md << "Sets named exactly right (every hidden effect and nothing else): " << exact << " of " << sets.size() << ".\n";
     md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
     // What the models on the list could not explain, and how far above the sets' own floors.
@@ -377,14 +435,6 @@ std::string scoreStudy(const fs::path& dir)
     if (standInSets > 0)
         md << "Possible stand-ins set aside beside a residual beyond the usual one (rule 6), not named: on " << standInSets << " of " << sets.size()
            << " sets; " << standInsNotHidden << " of them not hidden in their set (a wrong label kept out), " << standInsHidden << " hidden (a miss).\n";
-    json plan;
-    if (fs::exists(dir / "plan.json")) {
-        try {
-            std::ifstream(dir / "plan.json") >> plan;
-        } catch (const json::exception& e) {
-            throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
-        }
-    }
     if (plan.contains("rig")) {
         std::string fixed;
         for (const auto& [k, v] : plan["rig"].items()) fixed += (fixed.empty() ? "" : ", ") + k + fmt(" = %.3g", v.get<double>());
@@ -518,22 +568,40 @@ std::string scoreStudy(const fs::path& dir)
                                   {"beta_scale", "beta_error", 1.0, 1.0},
                                   {"rod_effusivity_scale", "rod_effusivity", 0.0, dsp::ThermalParams{}.rodEffusivity},
                                   {"scale_n_per_unit", "scale_n_per_unit", 0.0, 1.0}};
-    md << "\n| calibrated nuisance | sets | median error | worst error | truth inside the 95 % interval |\n|---|---|---|---|---|\n";
+    // Each fitted nuisance's discrepancy: the spread of (value - truth) beyond its curvature
+    // interval, as for the findings' parameters (what `--model-discrepancy NAME=SD` takes).
+    md << "\n| calibrated nuisance | sets | median error | worst error | truth inside the 95 % interval | inside the curvature interval alone | "
+          "discrepancy beyond the curvature (SD) |\n|---|---|---|---|---|---|---|\n";
     for (const auto& [name, rigKey, offset, divisor] : nuisanceOfRig) {
         std::vector<double> err;
-        int inside = 0;
+        int inside = 0, insideCurvature = 0, withCurvature = 0;
+        double excessSum = 0.0;
         for (const auto& s : sets) {
             if (!s.calibration.count(name) || !s.rig.count(rigKey)) continue;
             const double t = offset + s.rig.at(rigKey) / divisor;
             const auto& c = s.calibration.at(name);
             err.push_back(std::abs(c[0] / t - 1.0));
             inside += t >= c[1] && t <= c[2];
+            if (const auto k = s.calibrationCurvature.find(name); k != s.calibrationCurvature.end()) {
+                ++withCurvature;
+                insideCurvature += t >= k->second[0] && t <= k->second[1];
+                const double sd = (k->second[1] - k->second[0]) / (2.0 * 1.96);
+                excessSum += (c[0] - t) * (c[0] - t) - sd * sd;
+            }
         }
         if (err.empty()) continue;
         std::sort(err.begin(), err.end());
         md << "| " << name << " | " << err.size() << " | " << fmt("%.1f %%", 100.0 * err[err.size() / 2]) << " | " << fmt("%.1f %%", 100.0 * err.back())
-           << " | " << inside << " of " << err.size() << " |\n";
+           << " | " << inside << " of " << err.size() << " | ";
         summary["calibration"][name] = {{"sets", err.size()}, {"median_error", err[err.size() / 2]}, {"worst_error", err.back()}, {"covered", inside}};
+        if (withCurvature > 0) {
+            const double sd = std::sqrt(std::max(0.0, excessSum / withCurvature));
+            md << insideCurvature << " of " << withCurvature << " | " << fmt("%.3g", sd) << " |\n";
+            summary["calibration"][name]["covered_by_curvature"] = insideCurvature;
+            summary["calibration_discrepancy"][name] = sd;
+        } else {
+            md << "- | - |\n";
+        }
     }
     // Held-out error where nothing was hidden: what a good fit reaches on this rig population.
     std::vector<double> nullBase;
@@ -549,7 +617,7 @@ std::string scoreStudy(const fs::path& dir)
     for (const auto& p : physicalParameterNames()) csv << "," << p << "_true," << p << "_found," << p << "_ci_low," << p << "_ci_high";
     const std::vector<std::string> rigCols{"noise_n", "inharmonicity", "bridge_z0y", "headroom", "tension_error", "beta_error", "mu_level", "rod_effusivity"};
     for (const auto& r : rigCols) csv << "," << r;
-    csv << "\n";
+    csv << ",study\n";
     json perSet = json::array();
     md << "\n| set | hidden | found | held-out error baseline -> final |\n|---|---|---|---|\n";
     for (const auto& s : sets) {
@@ -563,18 +631,23 @@ std::string scoreStudy(const fs::path& dir)
             for (int k = 0; k < 3; ++k) csv << "," << (s.estimate.count(p) ? fmt("%.6g", s.estimate.at(p)[static_cast<std::size_t>(k)]) : "");
         }
         for (const auto& r : rigCols) csv << "," << (s.rig.count(r) ? fmt("%.6g", s.rig.at(r)) : "");
-        csv << "\n";
+        csv << "," << s.study << "\n";
         std::string found = joined(s.found);
         for (const auto& [p, v] : s.estimate) found += " " + p + fmt("=%.3g", v[0]);
         std::string hidden = joined(s.hidden);
         for (const auto& [p, v] : s.truth) hidden += " " + p + fmt("=%.3g", v);
-        md << "| " << s.index << " | " << hidden << " | " << found
+        md << "| " << (s.study.empty() ? "" : s.study + "/") << s.index << " | " << hidden << " | " << found
            << (s.unexplained ? (s.beyondUsual ? " (+ unexplained residual, more than usual)" : " (+ unexplained residual)") : "")
            << (s.standIns.empty() ? "" : " (possible stand-in, not named: " + joined(s.standIns) + ")") << " | "
            << fmt("%.3f", s.baseline) << fmt(" -> %.3f", s.final) << " |\n";
-        perSet.push_back({{"set", s.index}, {"seed", s.seed}, {"hidden", s.hidden}, {"found", s.found}, {"truth", s.truth},
+        perSet.push_back({{"set", s.index}, {"study", s.study}, {"seed", s.seed}, {"hidden", s.hidden}, {"found", s.found}, {"truth", s.truth},
                           {"baseline_error", s.baseline}, {"final_error", s.final}, {"unexplained", s.unexplained},
                           {"beyond_usual", s.beyondUsual}, {"stand_ins", s.standIns}, {"over_floor", s.overFloor}});
+    }
+    if (pooled) {
+        json from = json::array();
+        for (const fs::path& study : studies) from.push_back(study.filename().string());
+        summary["pooled_from"] = from;
     }
     std::ofstream(dir / "study.json") << json{{"summary", summary}, {"sets", perSet}}.dump(1) << "\n";
     std::ofstream(dir / "summary.md") << md.str();

@@ -504,10 +504,24 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
     json setB = withCalibration(1.0, 0.99, 1.01, 1.0, 0.99, 1.01);
     setB["calibration"]["values"]["scale_n_per_unit"] = {{"value", 2.1}, {"ci95", {2.05, 2.2}}};
     writeSet(dir, 1, {{"effects", json::array()}, {"params", json::object()}, {"rig", rigB}, {"gain_units_per_N", 0.5}}, setB);
+    // The curvature intervals alone, which the reported ones widen: both miss their truths.
+    for (int k : {0, 1}) {
+        json d;
+        std::ifstream(setDir(dir, k) / "diagnosis" / "diagnosis.json") >> d;
+        const double v = d["calibration"]["values"]["tension_scale"]["value"].get<double>();
+        d["calibration"]["values"]["tension_scale"]["ci95_curvature"] = {v - 0.005, v + 0.005};
+        std::ofstream(setDir(dir, k) / "diagnosis" / "diagnosis.json") << d.dump();
+    }
     const std::string md = scoreStudy(dir);
     json study;
     std::ifstream(dir / "study.json") >> study;
     const json& c = study["summary"]["calibration"];
+    EXPECT_EQ(c["tension_scale"]["covered_by_curvature"], 0);
+    // The discrepancy beyond the curvature: misses of 0.01 and 0.03, each curvature SD 0.005 / 1.96.
+    const double curvatureVariance = std::pow(0.005 / 1.96, 2);
+    EXPECT_NEAR(study["summary"]["calibration_discrepancy"]["tension_scale"].get<double>(),
+                std::sqrt((0.01 * 0.01 + 0.03 * 0.03) / 2.0 - curvatureVariance), 1e-9);
+    EXPECT_FALSE(study["summary"]["calibration_discrepancy"].contains("beta_scale")) << "no curvature interval given, none measured";
     EXPECT_EQ(c["tension_scale"]["sets"], 2);
     EXPECT_EQ(c["tension_scale"]["covered"], 1);
     EXPECT_NEAR(c["tension_scale"]["worst_error"].get<double>(), 1.0 / 0.97 - 1.0, 1e-9);
@@ -648,4 +662,68 @@ TEST(Study, LeavesParametersThatAreNotIdentifiedOutOfTheCoverage)
     EXPECT_NEAR(s["coverage"].get<double>(), 0.5, 1e-12);
     EXPECT_NE(md.find("0 of 0 (1 not identified)"), std::string::npos) << md;
     fs::remove_all(dir);
+}
+
+// Studies of several seeds scored as one: the counts add up over both, the usual residual is the
+// largest over all their null sets, each set is labelled with its study, and what would make the
+// pool lie is refused: a set counted twice, studies of different strokes, or a pooled summary
+// written over one of its sources.
+TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
+{
+    const fs::path a = freshDir("pool-a"), b = freshDir("pool-b"), out = freshDir("pool-out");
+    const auto residual = [](json d, double overFloor) {
+        d["floor"] = {{"final_over_floor", overFloor}};
+        d["unexplained_residual"] = {{"ratio", overFloor}, {"beyond_usual", false}};
+        return d;
+    };
+    const json none = diagnosis(json::array({{{"effect", "none"}}}));
+    const json nothing{{"effects", json::array()}, {"params", json::object()}};
+    const auto truth = [](json t, std::uint64_t seed) { t["seed"] = seed; return t; };
+    writeSet(a, 0, truth(nothing, 11), residual(none, 6.5));
+    writeSet(a, 1, truth({{"effects", {"hertzian_contact"}}, {"params", {{"load_exponent", 0.67}}}}, 12),
+             diagnosis(json::array({finding("hertzian_contact", "load_exponent", 0.70, 0.65, 0.75)})));
+    writeSet(b, 0, truth(nothing, 21), residual(none, 9.25));
+    writeSet(b, 1, truth({{"effects", {"hertzian_contact"}}, {"params", {{"load_exponent", 0.80}}}}, 22), none);
+    writeSet(b, 2, truth({{"effects", {"hertzian_contact"}}, {"params", {{"load_exponent", 0.60}}}}, 23),
+             diagnosis(json::array({finding("hertzian_contact", "load_exponent", 0.62, 0.57, 0.66)})));
+    std::ofstream(a / "plan.json") << json{{"grid", 12}, {"seed", 1}, {"sets", json::array()}}.dump();
+    std::ofstream(b / "plan.json") << json{{"grid", 12}, {"seed", 2}, {"plan", 2}, {"sets", json::array()}}.dump();
+
+    const std::string md = scoreStudies(out, {a, b});
+    json study;
+    std::ifstream(out / "study.json") >> study;
+    const json& s = study["summary"];
+    EXPECT_EQ(s["sets"], 5);
+    EXPECT_EQ(s["null_sets"], 2);
+    EXPECT_EQ(s["detection"]["hertzian_contact"]["hidden"], 3);
+    EXPECT_EQ(s["detection"]["hertzian_contact"]["named"], 2);
+    EXPECT_EQ(s["parameters"]["load_exponent"]["named"], 2);
+    EXPECT_DOUBLE_EQ(s["usual_residual_measured"].get<double>(), 9.25); // study b's null, not a's 6.5
+    EXPECT_EQ(s["pooled_from"], json({a.filename().string(), b.filename().string()}));
+    EXPECT_EQ(study["sets"][3]["study"], b.filename().string());
+    EXPECT_EQ(study["sets"][3]["set"], 1);
+    EXPECT_NE(md.find("Scored together from 2 studies: " + a.filename().string() + " (seed 1, 2 sets), " + b.filename().string() + " (seed 2, 3 sets)."),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("| " + b.filename().string() + "/2 | hertzian_contact"), std::string::npos) << md;
+    EXPECT_FALSE(fs::exists(a / "study.json")) << "the sources stay as they were";
+
+    // The pooled summary may not overwrite a source's, nor count a set twice.
+    EXPECT_THROW(scoreStudies(a, {a, b}), LabError);
+    EXPECT_THROW(scoreStudies(out, {a, a}), LabError);
+    // Different strokes per set are a different population.
+    std::ofstream(b / "plan.json") << json{{"grid", 8}, {"seed", 2}, {"sets", json::array()}}.dump();
+    try {
+        scoreStudies(out, {a, b});
+        ADD_FAILURE() << "studies of grids 12 and 8 were pooled";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("must share the grid"), std::string::npos) << e.what();
+    }
+    // One study scored on its own keeps its plain labels and gains no "pooled_from".
+    scoreStudy(a);
+    json alone;
+    std::ifstream(a / "study.json") >> alone;
+    EXPECT_FALSE(alone["summary"].contains("pooled_from"));
+    EXPECT_EQ(alone["sets"][0]["study"], "");
+    for (const auto& d : {a, b, out}) fs::remove_all(d);
 }

@@ -19,6 +19,7 @@ struct StudyCommand {
     std::string out = "study";
     bool scoreOnly = false;
     std::vector<std::string> rigValues;
+    std::vector<std::string> pool;
 
     CLI::App* add(CLI::App& app)
     {
@@ -54,6 +55,11 @@ struct StudyCommand {
         cmd->add_flag("--generate-only", options.generateOnly,
                       "Only simulate the sets and keep them; a later run without it diagnoses the kept sets instead of simulating them again");
         cmd->add_flag("--score-only", scoreOnly, "Only score what OUT already holds");
+        cmd->add_option("--pool", pool,
+                        "Score these finished studies (folders) together into OUT, as one study of all their sets; runs no set. They must "
+                        "share grid, gesture, units and fixed rig values, and OUT must be none of them")
+            ->check(CLI::ExistingDirectory)
+            ->excludes("--only", "--hiding", "--generate-only", "--keep-sets", "--score-only");
         cmd->add_flag("-q,--quiet", options.quiet, "No progress and no summary");
         return cmd;
     }
@@ -61,6 +67,12 @@ struct StudyCommand {
     int run()
     {
         options.rig = parseRigValues(rigValues);
+        if (!pool.empty()) {
+            if (!Distributed::instance().isRoot()) return 0;
+            const std::string summary = scoreStudies(out, std::vector<std::filesystem::path>(pool.begin(), pool.end()));
+            if (!options.quiet) std::printf("%s\nwrote %s/study.csv, study.json, summary.md, study.png\n", summary.c_str(), out.c_str());
+            return 0;
+        }
         if (!scoreOnly) {
             Progress progress("study", !options.quiet && Distributed::instance().isRoot());
             runStudy(out, options, [&](const std::string&, double x) { progress.update(x); });

@@ -62,4 +62,10 @@ void runStudy(const std::filesystem::path& dir, const StudyOptions& o, const std
 /// DIR/study.json, DIR/summary.md and DIR/study.png. Returns the summary's markdown.
 std::string scoreStudy(const std::filesystem::path& dir);
 
+/// Scores the sets of several studies as one (seeds differ, the rig population does not: their
+/// grid, gesture, units and fixed rig values must match, and no set seed may appear twice), and
+/// writes the same four files into `dir`, which must not be one of them. More sets pin the
+/// detection against size, the coverage and the usual residual better than any one study.
+std::string scoreStudies(const std::filesystem::path& dir, const std::vector<std::filesystem::path>& studies);
+
 } // namespace rosin::lab
