@@ -457,8 +457,16 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 // (a parameter that cancels out of the model gets its whole range, whatever the curvature)
                 const bool canFix = identifiable(names[k]);
                 const double lo = canFix ? std::max(v - hw, bottom) : bottom, hi = canFix ? std::min(v + hw, top) : top;
-                if (isNuisance(names[k]))
-                    d.calibration.push_back({names[k], nuisanceMeaning(names[k]), v, lo, hi});
+                if (isNuisance(names[k])) {
+                    // What the fit needed is the model's value, which stands off the rig's by more
+                    // than the curvature says (calibrationDiscrepancy): widened in quadrature.
+                    const auto sd = o.calibrationDiscrepancy.find(names[k]);
+                    const double wide = std::hypot(hw, sd == o.calibrationDiscrepancy.end() ? 0.0 : 1.96 * sd->second);
+                    const double wideLo = std::max(v - wide, bottom), wideHi = std::min(v + wide, top);
+                    std::string meaning = nuisanceMeaning(names[k]);
+                    if (wideHi - wideLo >= 0.9 * (top - bottom)) meaning += "; the data do not narrow its prior: the value is what the model needed";
+                    d.calibration.push_back({names[k], meaning, v, wideLo, wideHi, {lo, hi}});
+                }
                 for (auto& f : d.findings)
                     if (f.parameters.count(names[k])) {
                         // the bootstrap's normal interval and the moved halves stay inside the range too

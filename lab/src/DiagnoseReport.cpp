@@ -328,7 +328,10 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     json calibration{{"scale_n_per_unit", d.scale}, {"trigger_offsets_detected", d.triggersDetected}};
     json rigUnknowns = json::array();
     for (const auto& t : d.rigUnknowns) rigUnknowns.push_back({{"unknown", t.unknown}, {"setting", t.setting}, {"moves", t.moves}});
-    for (const auto& c : d.calibration) calibration["values"][c.name] = {{"value", c.value}, {"ci95", {c.low, c.high}}, {"meaning", c.meaning}};
+    for (const auto& c : d.calibration) {
+        calibration["values"][c.name] = {{"value", c.value}, {"ci95", {c.low, c.high}}, {"meaning", c.meaning}};
+        if (c.curvature.size() == 2) calibration["values"][c.name]["ci95_curvature"] = c.curvature;
+    }
     json residual = nullptr;
     if (d.residual.present)
         residual = {{"error", d.residual.error}, {"floor", d.residual.floor}, {"ratio", d.residual.ratio}, {"parts", d.residual.parts},

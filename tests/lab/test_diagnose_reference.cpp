@@ -167,6 +167,28 @@ TEST(DiagnoseReference, NamesNothingOnANullRig)
         EXPECT_NE(c.name, "rod_effusivity_scale") << "the rod's heat matters only to a thermal model";
     }
     EXPECT_NEAR(mu / (1.2 * o.truth.rig.at("mu_level") * (0.85 + 0.35 * o.truth.rig.at("mu_floor_scale")) / 1.2), 1.0, 0.03);
+    // The tension and bow position a fit needs are the model's: their curvature intervals held
+    // the rig's truth on 18 and 20 of 80 study sets. The reported interval adds the calibration
+    // discrepancy in quadrature (clipped to the prior) and holds the truth here; the curvature
+    // interval alone is kept beside it.
+    const DiagnoseOptions defaults;
+    const std::map<std::string, double> truth{{"tension_scale", 1.0 + o.truth.rig.at("tension_error")},
+                                              {"beta_scale", 1.0 + o.truth.rig.at("beta_error")}};
+    int checked = 0;
+    for (const auto& c : o.d.calibration) {
+        if (!truth.count(c.name)) continue;
+        ++checked;
+        ASSERT_EQ(c.curvature.size(), 2u) << c.name;
+        const auto [bottom, top] = diag::parameterBounds().at(c.name);
+        const double curvatureHalf = std::max(c.value - c.curvature[0], c.curvature[1] - c.value);
+        const double wide = std::hypot(curvatureHalf, 1.96 * defaults.calibrationDiscrepancy.at(c.name));
+        EXPECT_NEAR(c.low, std::max(bottom, c.value - wide), 1e-3 * (top - bottom)) << c.name;
+        EXPECT_NEAR(c.high, std::min(top, c.value + wide), 1e-3 * (top - bottom)) << c.name;
+        EXPECT_LT(c.curvature[1] - c.curvature[0], c.high - c.low) << c.name;
+        EXPECT_GE(truth.at(c.name), c.low) << c.name;
+        EXPECT_LE(truth.at(c.name), c.high) << c.name;
+    }
+    EXPECT_EQ(checked, 2);
 }
 
 // A difference no candidate names: the same null rig with a string far stiffer than any the

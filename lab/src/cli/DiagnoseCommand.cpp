@@ -31,11 +31,13 @@ namespace {
 std::string defaultDiscrepancyText()
 {
     std::string text;
-    for (const auto& [name, sd] : DiagnoseOptions{}.modelDiscrepancy) {
-        char value[32];
-        std::snprintf(value, sizeof value, "%g", sd);
-        text += (text.empty() ? "" : ", ") + name + "=" + value;
-    }
+    const DiagnoseOptions defaults;
+    for (const auto* table : {&defaults.modelDiscrepancy, &defaults.calibrationDiscrepancy})
+        for (const auto& [name, sd] : *table) {
+            char value[32];
+            std::snprintf(value, sizeof value, "%g", sd);
+            text += (text.empty() ? "" : ", ") + name + "=" + value;
+        }
     return text;
 }
 
@@ -69,7 +71,8 @@ struct DiagnoseCommand {
             ->check(finiteIn(0, 1))
             ->capture_default_str();
         diagnoseCmd->add_option("--model-discrepancy", discrepancy,
-                                "NAME=SD: the model's own error for parameter NAME (r_A and zt_ratio relative, others absolute; 0 = none), "
+                                "NAME=SD: the model's own error for parameter NAME (r_A and zt_ratio relative, others absolute; 0 = none) or for a "
+                                "calibrated nuisance (tension_scale, beta_scale, rod_effusivity_scale: scales), "
                                 "instead of the study-calibrated default (" + defaultDiscrepancyText() + ")");
         diagnoseCmd->add_flag("!--no-nuisances", diagOptions.fitNuisances, "Do not fit tension, bow position and the bow side's thermal effusivity as calibration");
         diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
@@ -82,9 +85,11 @@ struct DiagnoseCommand {
             const auto eq = item.find('=');
             const std::string name = item.substr(0, eq);
             const double sd = eq != std::string::npos ? wholeNumber(item.substr(eq + 1)).value_or(std::nan("")) : std::nan("");
-            if (effectOfParameter(name) == "calibration" || !std::isfinite(sd) || sd < 0.0 || sd > 10.0) // not a finding's parameter
-                throw LabError("--model-discrepancy " + item + ": expected NAME=SD with NAME one of r_A, h0, p, load_exponent, shift_k, zt_ratio and SD from 0 to 10");
-            diagOptions.modelDiscrepancy[name] = sd;
+            const bool nuisance = diagOptions.calibrationDiscrepancy.count(name) > 0;
+            if ((effectOfParameter(name) == "calibration" && !nuisance) || !std::isfinite(sd) || sd < 0.0 || sd > 10.0) // neither a finding's parameter nor a nuisance
+                throw LabError("--model-discrepancy " + item + ": expected NAME=SD with NAME one of r_A, h0, p, load_exponent, shift_k, zt_ratio, "
+                               "tension_scale, beta_scale, rod_effusivity_scale and SD from 0 to 10");
+            (nuisance ? diagOptions.calibrationDiscrepancy : diagOptions.modelDiscrepancy)[name] = sd;
         }
         if (fs::exists(diagOut)) throw LabError(diagOut + ": already exists (choose a new folder)");
         const MeasurementSet set = readMeasurementSet(diagSet);
