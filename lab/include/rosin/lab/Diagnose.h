@@ -104,7 +104,7 @@ struct CalibrationValue {
     double value = 0, low = 0, high = 0;
     /// A fitted nuisance's interval from the local curvature alone, before the calibration
     /// discrepancy widened it (empty for values that are not fitted).
-    std::vector<double> curvature;
+    std::vector<double> curvature{};
 };
 
 struct Finding {
