@@ -302,6 +302,9 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     const bool pooled = studies.size() > 1 || (fs::exists(dir) && !fs::equivalent(dir, studies.front()));
     json plan = readPlan(studies.front());
     std::map<std::uint64_t, std::string> seenSeeds; // set seed -> where it was first met
+    // A set's units as its diagnosis read them: older plan.json files of newton studies do not
+    // say "units", so the pool also asks every diagnosis (first set met -> its units).
+    std::pair<std::string, std::string> unitsSeen;
     std::string sources;
     std::vector<Scored> sets;
     for (const fs::path& study : studies) {
@@ -368,6 +371,14 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
             if (s.unexplained && d["unexplained_residual"].contains("stand_ins"))
                 for (const auto& standIn : d["unexplained_residual"]["stand_ins"]) s.standIns.push_back(standIn["effect"].get<std::string>());
             if (pooled) s.study = study.filename().string();
+            if (d.contains("calibration") && d["calibration"].contains("values") && d["calibration"]["values"].contains("scale_n_per_unit")) {
+                const std::string meaning = d["calibration"]["values"]["scale_n_per_unit"].value("meaning", "");
+                const std::string units = meaning.rfind("sensor scale: the set is calibrated in N", 0) == 0 ? "N" : "V";
+                if (unitsSeen.first.empty()) unitsSeen = {units, f.string()};
+                else if (units != unitsSeen.first)
+                    throw LabError(f.string() + ": a set in " + units + " where " + unitsSeen.second + " is in " + unitsSeen.first +
+                                   ": studies scored together must share the sensor's units");
+            }
             // The same set counted twice (one study pooled twice, or two folders of one seed) would
             // pass for a larger study.
             if (const auto [at, fresh] = seenSeeds.emplace(s.seed, f.string()); !fresh && s.seed != 0)

@@ -719,6 +719,23 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     } catch (const LabError& e) {
         EXPECT_NE(std::string(e.what()).find("must share the grid"), std::string::npos) << e.what();
     }
+    // A newton study whose plan.json does not say so (older ones did not) is still told apart
+    // by its diagnoses' sensor scale.
+    std::ofstream(b / "plan.json") << json{{"grid", 12}, {"seed", 2}, {"sets", json::array()}}.dump();
+    const auto withScale = [](json d, const std::string& meaning) {
+        d["calibration"]["values"]["scale_n_per_unit"] = {{"value", 1.0}, {"ci95", {1.0, 1.0}}, {"meaning", meaning}};
+        return d;
+    };
+    writeSet(a, 0, truth(nothing, 11), withScale(residual(none, 6.5), "sensor scale (N per signal unit) from the pre-slip ramps"));
+    writeSet(b, 0, truth(nothing, 21), withScale(residual(none, 9.25), "sensor scale: the set is calibrated in N"));
+    try {
+        scoreStudies(out, {a, b});
+        ADD_FAILURE() << "a volt study and a newton study were pooled";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("must share the sensor's units"), std::string::npos) << e.what();
+    }
+    writeSet(b, 0, truth(nothing, 21), withScale(residual(none, 9.25), "sensor scale (N per signal unit) from the pre-slip ramps"));
+    EXPECT_NO_THROW(scoreStudies(out, {a, b}));
     // One study scored on its own keeps its plain labels and gains no "pooled_from".
     scoreStudy(a);
     json alone;
