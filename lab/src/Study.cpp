@@ -81,6 +81,7 @@ struct Scored {
     bool beyondUsual = false;  ///< the residual is above the usual ratio the diagnosis compared it with
     std::vector<std::string> standIns; ///< effects set aside beside a residual beyond the usual one (rule 6): not named
     double overFloor = 0;      ///< the final error over the set's noise-and-chaos floor
+    std::string units;         ///< "V" or "N" as the diagnosis read the set ("" when it does not say)
 };
 
 std::string joined(const std::vector<std::string>& v)
@@ -292,6 +293,66 @@ json populationOf(const json& plan)
         if (plan.contains(key)) p[key] = plan[key];
     return p;
 }
+/// One set's truth and diagnosis, as the scoring needs them (`f` is DIR/sets/NNN).
+Scored readScored(const fs::path& f)
+{
+    json t, d;
+    std::ifstream(f / "truth.json") >> t;
+    std::ifstream(f / "diagnosis" / "diagnosis.json") >> d;
+    Scored s;
+    s.index = std::stoi(f.filename().string());
+    s.seed = t.value("seed", 0ull);
+    s.hidden = t["effects"].get<std::vector<std::string>>();
+    s.truth = t["params"].get<std::map<std::string, double>>();
+    if (t.contains("rig")) s.rig = t["rig"].get<std::map<std::string, double>>();
+    // The sensor's true scale is the inverse of the gain the generator applied.
+    if (t.contains("gain_units_per_N") && t["gain_units_per_N"].get<double>() > 0.0)
+        s.rig["scale_n_per_unit"] = 1.0 / t["gain_units_per_N"].get<double>();
+    for (const auto& finding : d["findings"]) {
+        const std::string e = finding["effect"].get<std::string>();
+        if (e == "none") continue;
+        s.found.push_back(e);
+        for (const auto& [name, v] : finding["parameters"].items()) {
+            s.estimate[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
+            if (v.contains("identified") && !v["identified"].get<bool>()) s.unidentified.insert(name);
+            if (v.contains("ci95_bootstrap")) {
+                std::array<double, 2> w{v["ci95_bootstrap"][0].get<double>(), v["ci95_bootstrap"][1].get<double>()};
+                if (v.contains("ci95_curvature"))
+                    w = {std::min(w[0], v["ci95_curvature"][0].get<double>()), std::max(w[1], v["ci95_curvature"][1].get<double>())};
+                s.withoutHalves[name] = w;
+            }
+            if (v.contains("ci95_statistical")) {
+                const double x = v["value"].get<double>(), lo = v["ci95_statistical"][0].get<double>(), hi = v["ci95_statistical"][1].get<double>();
+                s.statistical[name] = {lo, hi};
+                const double down = v.contains("systematic_moves") ? v["systematic_moves"][0].get<double>() : 0.0;
+                const double up = v.contains("systematic_moves") ? v["systematic_moves"][1].get<double>() : 0.0;
+                const auto [rigLo, rigHi] = widenedInQuadrature(x, {lo, hi}, down, up);
+                s.withRig[name] = {rigLo, rigHi};
+            }
+        }
+    }
+    if (d.contains("calibration") && d["calibration"].contains("values"))
+        for (const auto& [name, v] : d["calibration"]["values"].items())
+            if (v["value"].is_number() && v["ci95"].size() == 2) {
+                s.calibration[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
+                if (v.contains("ci95_curvature") && v["ci95_curvature"].size() == 2)
+                    s.calibrationCurvature[name] = {v["ci95_curvature"][0].get<double>(), v["ci95_curvature"][1].get<double>()};
+            }
+    s.baseline = d["gain"]["baseline"].get<double>();
+    s.final = d["gain"]["final"].get<double>();
+    s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
+    if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
+    s.beyondUsual = s.unexplained && d["unexplained_residual"].value("beyond_usual", false);
+    if (s.unexplained && d["unexplained_residual"].contains("stand_ins"))
+        for (const auto& standIn : d["unexplained_residual"]["stand_ins"]) s.standIns.push_back(standIn["effect"].get<std::string>());
+    // The set's units as its diagnosis read them (older plan.json files of newton studies do not
+    // say "units").
+    if (d.contains("calibration") && d["calibration"].contains("values") && d["calibration"]["values"].contains("scale_n_per_unit")) {
+        const std::string meaning = d["calibration"]["values"]["scale_n_per_unit"].value("meaning", "");
+        s.units = meaning.rfind("sensor scale: the set is calibrated in N", 0) == 0 ? "N" : "V";
+    }
+    return s;
+}
 } // namespace
 
 std::string scoreStudy(const fs::path& dir) { return scoreStudies(dir, {dir}); }
@@ -302,9 +363,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     const bool pooled = studies.size() > 1 || (fs::exists(dir) && !fs::equivalent(dir, studies.front()));
     json plan = readPlan(studies.front());
     std::map<std::uint64_t, std::string> seenSeeds; // set seed -> where it was first met
-    // A set's units as its diagnosis read them: older plan.json files of newton studies do not
-    // say "units", so the pool also asks every diagnosis (first set met -> its units).
-    std::pair<std::string, std::string> unitsSeen;
+    std::pair<std::string, std::string> unitsSeen; // the first set's units (Scored::units) and where it was met
     std::string sources;
     std::vector<Scored> sets;
     for (const fs::path& study : studies) {
@@ -321,62 +380,12 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         std::sort(folders.begin(), folders.end());
         for (const fs::path& f : folders) {
             if (!fs::exists(f / "diagnosis" / "diagnosis.json") || !fs::exists(f / "truth.json")) continue;
-            json t, d;
-            std::ifstream(f / "truth.json") >> t;
-            std::ifstream(f / "diagnosis" / "diagnosis.json") >> d;
-            Scored s;
-            s.index = std::stoi(f.filename().string());
-            s.seed = t.value("seed", 0ull);
-            s.hidden = t["effects"].get<std::vector<std::string>>();
-            s.truth = t["params"].get<std::map<std::string, double>>();
-            if (t.contains("rig")) s.rig = t["rig"].get<std::map<std::string, double>>();
-            // The sensor's true scale is the inverse of the gain the generator applied.
-            if (t.contains("gain_units_per_N") && t["gain_units_per_N"].get<double>() > 0.0)
-                s.rig["scale_n_per_unit"] = 1.0 / t["gain_units_per_N"].get<double>();
-            for (const auto& finding : d["findings"]) {
-                const std::string e = finding["effect"].get<std::string>();
-                if (e == "none") continue;
-                s.found.push_back(e);
-                for (const auto& [name, v] : finding["parameters"].items()) {
-                    s.estimate[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
-                    if (v.contains("identified") && !v["identified"].get<bool>()) s.unidentified.insert(name);
-                    if (v.contains("ci95_bootstrap")) {
-                        std::array<double, 2> w{v["ci95_bootstrap"][0].get<double>(), v["ci95_bootstrap"][1].get<double>()};
-                        if (v.contains("ci95_curvature"))
-                            w = {std::min(w[0], v["ci95_curvature"][0].get<double>()), std::max(w[1], v["ci95_curvature"][1].get<double>())};
-                        s.withoutHalves[name] = w;
-                    }
-                    if (v.contains("ci95_statistical")) {
-                        const double x = v["value"].get<double>(), lo = v["ci95_statistical"][0].get<double>(), hi = v["ci95_statistical"][1].get<double>();
-                        s.statistical[name] = {lo, hi};
-                        const double down = v.contains("systematic_moves") ? v["systematic_moves"][0].get<double>() : 0.0;
-                        const double up = v.contains("systematic_moves") ? v["systematic_moves"][1].get<double>() : 0.0;
-                        const auto [rigLo, rigHi] = widenedInQuadrature(x, {lo, hi}, down, up);
-                        s.withRig[name] = {rigLo, rigHi};
-                    }
-                }
-            }
-            if (d.contains("calibration") && d["calibration"].contains("values"))
-                for (const auto& [name, v] : d["calibration"]["values"].items())
-                    if (v["value"].is_number() && v["ci95"].size() == 2) {
-                        s.calibration[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
-                        if (v.contains("ci95_curvature") && v["ci95_curvature"].size() == 2)
-                            s.calibrationCurvature[name] = {v["ci95_curvature"][0].get<double>(), v["ci95_curvature"][1].get<double>()};
-                    }
-            s.baseline = d["gain"]["baseline"].get<double>();
-            s.final = d["gain"]["final"].get<double>();
-            s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
-            if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
-            s.beyondUsual = s.unexplained && d["unexplained_residual"].value("beyond_usual", false);
-            if (s.unexplained && d["unexplained_residual"].contains("stand_ins"))
-                for (const auto& standIn : d["unexplained_residual"]["stand_ins"]) s.standIns.push_back(standIn["effect"].get<std::string>());
+            Scored s = readScored(f);
             if (pooled) s.study = study.filename().string();
-            if (d.contains("calibration") && d["calibration"].contains("values") && d["calibration"]["values"].contains("scale_n_per_unit")) {
-                const std::string meaning = d["calibration"]["values"]["scale_n_per_unit"].value("meaning", "");
-                const std::string units = meaning.rfind("sensor scale: the set is calibrated in N", 0) == 0 ? "N" : "V";
-                if (unitsSeen.first.empty()) unitsSeen = {units, f.string()};
-                else if (units != unitsSeen.first)
-                    throw LabError(f.string() + ": a set in " + units + " where " + unitsSeen.second + " is in " + unitsSeen.first +
+            if (!s.units.empty()) {
+                if (unitsSeen.first.empty()) unitsSeen = {s.units, f.string()};
+                else if (s.units != unitsSeen.first)
+                    throw LabError(f.string() + ": a set in " + s.units + " where " + unitsSeen.second + " is in " + unitsSeen.first +
                                    ": studies scored together must share the sensor's units");
             }
             // The same set counted twice (one study pooled twice, or two folders of one seed) would
