@@ -562,14 +562,16 @@ TEST(ProcessorThreads, StatesMapsLearnAndEnginesChangeWhileAudioRuns)
 }
 
 namespace {
-/// Blocks as a host plays them while it bypasses the plugin (JUCE calls processBlockBypassed).
-double bypassedRms(RosinProcessor& p, int count, juce::MidiBuffer midi = {}, float* firstHalfRms = nullptr)
+/// The rms of `count` blocks of the left channel, played as a host plays them, bypassed or not
+/// (JUCE then calls processBlockBypassed); `firstHalfRms` takes the first block's first half.
+double blocksRms(RosinProcessor& p, int count, bool bypassed, juce::MidiBuffer midi = {}, float* firstHalfRms = nullptr)
 {
     juce::AudioBuffer<float> buffer(2, 256);
     double sum = 0.0;
     for (int b = 0; b < count; ++b) {
         buffer.clear();
-        p.processBlockBypassed(buffer, midi);
+        if (bypassed) p.processBlockBypassed(buffer, midi);
+        else p.processBlock(buffer, midi);
         midi.clear();
         double half = 0.0;
         for (int i = 0; i < 256; ++i) {
@@ -578,19 +580,6 @@ double bypassedRms(RosinProcessor& p, int count, juce::MidiBuffer midi = {}, flo
             if (i < 128) half += x * x;
         }
         if (b == 0 && firstHalfRms) *firstHalfRms = static_cast<float>(std::sqrt(half / 128.0));
-    }
-    return std::sqrt(sum / (count * 256.0));
-}
-
-double playedRms(RosinProcessor& p, int count, juce::MidiBuffer midi = {})
-{
-    juce::AudioBuffer<float> buffer(2, 256);
-    double sum = 0.0;
-    for (int b = 0; b < count; ++b) {
-        buffer.clear();
-        p.processBlock(buffer, midi);
-        midi.clear();
-        for (int i = 0; i < 256; ++i) sum += buffer.getSample(0, i) * buffer.getSample(0, i);
     }
     return std::sqrt(sum / (count * 256.0));
 }
@@ -605,18 +594,18 @@ TEST(ProcessorBypass, ANoteReleasedWhileBypassedDoesNotSoundWhenTheBypassEnds)
     p.setPlayConfigDetails(0, 2, 48000.0, 256);
     p.prepareToPlay(48000.0, 256);
     p.setNonRealtime(true);
-    const double playing = playedRms(p, 80, messages({juce::MidiMessage::noteOn(1, 45, 0.8f)}));
+    const double playing = blocksRms(p, 80, false, messages({juce::MidiMessage::noteOn(1, 45, 0.8f)}));
     ASSERT_GT(playing, 0.02);
     // The first bypassed block fades (10 ms = 480 samples) rather than cuts; then silence.
     float fadeStart = 0.0f;
-    bypassedRms(p, 2, {}, &fadeStart);
+    blocksRms(p, 2, true, {}, &fadeStart);
     EXPECT_GT(fadeStart, 0.2 * playing);
-    EXPECT_EQ(bypassedRms(p, 20, messages({juce::MidiMessage::noteOff(1, 45)})), 0.0);
+    EXPECT_EQ(blocksRms(p, 20, true, messages({juce::MidiMessage::noteOff(1, 45)})), 0.0);
     // Bypass off: the string was released while bypassed, so it has rung down (0.5 s after).
-    playedRms(p, 94);
-    EXPECT_LT(playedRms(p, 47), 1e-3);
+    blocks(p, 94);
+    EXPECT_LT(blocksRms(p, 47, false), 1e-3);
     // A note held through the bypass plays on after it, and the next note plays.
-    EXPECT_GT(playedRms(p, 80, messages({juce::MidiMessage::noteOn(1, 50, 0.8f)})), 0.02);
-    bypassedRms(p, 40);
-    EXPECT_GT(playedRms(p, 40), 0.02);
+    EXPECT_GT(blocksRms(p, 80, false, messages({juce::MidiMessage::noteOn(1, 50, 0.8f)})), 0.02);
+    blocksRms(p, 40, true);
+    EXPECT_GT(blocksRms(p, 40, false), 0.02);
 }
