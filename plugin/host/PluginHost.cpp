@@ -259,6 +259,12 @@ int PluginHost::bypassParameterIndex() const
     return bypass != nullptr ? impl_->plugin->getParameters().indexOf(bypass) : -1;
 }
 
+int PluginHost::parameterIndex(const std::string& id) const
+{
+    auto* p = impl_->find(id);
+    return p != nullptr ? impl_->plugin->getParameters().indexOf(p) : -1;
+}
+
 void PluginHost::setParameterNormalised(int index, float value)
 {
     const auto& params = impl_->plugin->getParameters();

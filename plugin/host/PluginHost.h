@@ -98,6 +98,8 @@ public:
     int parameterCount() const;
     /// The index of the host's bypass parameter (normalised 1 = bypassed), or -1 when it has none.
     int bypassParameterIndex() const;
+    /// The index of a parameter by the plugin's own ID (as setParameter takes it), or -1.
+    int parameterIndex(const std::string& id) const;
 
     /// Times processBlock as a DAW would call it (real-time mode): `midi` is sent in the first
     /// block, `warmup` seconds run untimed, then `reps` passes of `seconds` each are timed.

@@ -185,13 +185,21 @@ int validate(const std::filesystem::path& plugin, const ValidateOptions& o, std:
             // step it bypassed Rosin for about half of a VST3 walk and, as LV2's first parameter,
             // for the whole LV2 walk, which then heard nothing of what the parameters did.
             const int bypass = h.bypassParameterIndex();
+            // The HID input stays off too: on, it hands the bow to the device, and by now the
+            // replay of check 2 has ended, so the walk heard a lifted pen (silence) for as long as
+            // its value stayed above 0.5. How long that was depended on how fast this thread ran:
+            // a loaded CI machine's whole LV2 walk (63 sweeps) was silent, an idle one's was not.
+            // Switching the input while audio runs is the processor tests' job (FakePenPlaysAVoice...,
+            // StatesMapsLearnAndEnginesChangeWhileAudioRuns, the latter under ThreadSanitizer).
+            const int hidInput = h.parameterIndex("hid_input");
+            if (hidInput >= 0) h.setParameterNormalised(hidInput, 0.0f);
             std::thread automation([&] {
                 std::mt19937 rng(o.seed);
                 std::uniform_real_distribution<float> step(-0.08f, 0.08f);
                 std::vector<float> value(static_cast<std::size_t>(count), 0.5f);
                 while (!done.load()) {
                     for (int p = 0; p < count; ++p) {
-                        if (p == bypass) continue;
+                        if (p == bypass || p == hidInput) continue;
                         float& v = value[static_cast<std::size_t>(p)];
                         v = std::clamp(v + step(rng), 0.0f, 1.0f);
                         h.setParameterNormalised(p, v);
