@@ -55,6 +55,10 @@ struct StudySet {
 /// vocabulary, in an order shuffled from the seed.
 std::vector<StudySet> planStudy(const StudyOptions& o);
 
+/// A set's effects as one label, "thermal_memory+hertzian_contact" ("none" for a null set), as
+/// the study's files and progress lines write them.
+std::string effectsLabel(const std::vector<std::string>& effects);
+
 /// Runs the plan into `dir` (DIR/sets/NNN/{truth.json, diagnosis/}), then scores it.
 void runStudy(const std::filesystem::path& dir, const StudyOptions& o, const std::function<void(const std::string&, double)>& progress = {});
 
