@@ -185,10 +185,11 @@ int validate(const std::filesystem::path& plugin, const ValidateOptions& o, std:
             // step it bypassed Rosin for about half of a VST3 walk and, as LV2's first parameter,
             // for the whole LV2 walk, which then heard nothing of what the parameters did.
             const int bypass = h.bypassParameterIndex();
-            // The HID input stays off too: on, it hands the bow to the device, and by now the
-            // replay of check 2 has ended, so the walk heard a lifted pen (silence) for as long as
-            // its value stayed above 0.5. How long that was depended on how fast this thread ran:
-            // a loaded CI machine's whole LV2 walk (63 sweeps) was silent, an idle one's was not.
+            // The HID input stays off too: on, it hands the bow (force, speed, contact) to the
+            // replayed pen, so the walked bow parameters do nothing and the walk played near
+            // silence (held on: peak 3e-4 over 0.5 s, 2e-3 over 2 s). Walked, it was on from about
+            // sweep 2 to 58, so whether the walk was heard depended on how fast this thread ran: a
+            // loaded CI machine's whole LV2 walk (61 sweeps) failed, an idle one's (70-140) passed.
             // Switching the input while audio runs is the processor tests' job (FakePenPlaysAVoice...,
             // StatesMapsLearnAndEnginesChangeWhileAudioRuns, the latter under ThreadSanitizer).
             const int hidInput = h.parameterIndex("hid_input");
