@@ -510,6 +510,7 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
         std::ifstream(setDir(dir, k) / "diagnosis" / "diagnosis.json") >> d;
         const double v = d["calibration"]["values"]["tension_scale"]["value"].get<double>();
         d["calibration"]["values"]["tension_scale"]["ci95_curvature"] = {v - 0.005, v + 0.005};
+        if (k == 1) d["calibration"]["values"]["beta_scale"]["ci95_curvature"] = {0.995, 1.005};
         std::ofstream(setDir(dir, k) / "diagnosis" / "diagnosis.json") << d.dump();
     }
     const std::string md = scoreStudy(dir);
@@ -521,7 +522,18 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
     const double curvatureVariance = std::pow(0.005 / 1.96, 2);
     EXPECT_NEAR(study["summary"]["calibration_discrepancy"]["tension_scale"].get<double>(),
                 std::sqrt((0.01 * 0.01 + 0.03 * 0.03) / 2.0 - curvatureVariance), 1e-9);
-    EXPECT_FALSE(study["summary"]["calibration_discrepancy"].contains("beta_scale")) << "no curvature interval given, none measured";
+    // Set A's bow position carries no curvature interval: a diagnosis from before the widening,
+    // whose reported interval was the curvature's; set B's was widened from 0.995-1.005. Misses
+    // of 0 and 0.02 beyond curvature SDs of 0.02 / 3.92 (A's reported interval) and 0.01 / 3.92.
+    EXPECT_NEAR(study["summary"]["calibration_discrepancy"]["beta_scale"].get<double>(),
+                std::sqrt((0.02 * 0.02 - std::pow(0.02 / 3.92, 2) - std::pow(0.01 / 3.92, 2)) / 2.0), 1e-9);
+    EXPECT_EQ(c["beta_scale"]["covered_by_curvature"], 1);
+    EXPECT_EQ(c["beta_scale"]["not_widened"]["sets"], 1);
+    EXPECT_EQ(c["beta_scale"]["not_widened"]["covered"], 1);
+    EXPECT_FALSE(c["tension_scale"].contains("not_widened"));
+    // Told apart in the table: B's widened interval misses, A's older one holds.
+    EXPECT_NE(md.find("| 0 of 1 (and 1 of 1 diagnosed before the widening, the curvature interval) |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| 0 of 1 (diagnosed before the widening: the curvature interval) |"), std::string::npos) << md; // effusivity
     EXPECT_EQ(c["tension_scale"]["sets"], 2);
     EXPECT_EQ(c["tension_scale"]["covered"], 1);
     EXPECT_NEAR(c["tension_scale"]["worst_error"].get<double>(), 1.0 / 0.97 - 1.0, 1e-9);
@@ -529,6 +541,7 @@ TEST(Study, ScoresTheCalibratedNuisancesAgainstTheRig)
     EXPECT_NEAR(c["beta_scale"]["worst_error"].get<double>(), 1.0 - 1.0 / 1.02, 1e-9);
     EXPECT_EQ(c["rod_effusivity_scale"]["sets"], 1);
     EXPECT_EQ(c["rod_effusivity_scale"]["covered"], 0);
+    EXPECT_EQ(c["rod_effusivity_scale"]["not_widened"]["sets"], 1);
     EXPECT_NEAR(c["rod_effusivity_scale"]["worst_error"].get<double>(), 1.0 - 1.1 / 1.2, 1e-9);
     EXPECT_EQ(c["scale_n_per_unit"]["sets"], 2);
     EXPECT_EQ(c["scale_n_per_unit"]["covered"], 1);
