@@ -379,6 +379,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     // The model discrepancy this study measures: the spread of (found - true) beyond what the
     // statistical and rig-unknown intervals allow, by moments (relative for r_A and zt_ratio).
     std::map<std::string, std::pair<double, int>> excess;
+    std::map<std::string, std::pair<int, int>> coverageByStudy; ///< pooled: study -> covered, intervals
     for (const std::string& p : physicalParameterNames()) {
         std::vector<double> err;
         int within = 0, inside = 0, unidentified = 0;
@@ -399,6 +400,8 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
             inside += in;
             covered += in;
             ++intervals;
+            coverageByStudy[s.study].first += in;
+            ++coverageByStudy[s.study].second;
             const auto narrow = s.withoutHalves.find(p);
             coveredWithoutHalves += narrow != s.withoutHalves.end() ? t >= narrow->second[0] && t <= narrow->second[1] : in;
             const auto stat = s.statistical.find(p);
@@ -431,6 +434,17 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
        << " (" << coveredStatistical << fmt("); with the rig unknowns, without the model discrepancy: %.0f %%", intervals ? 100.0 * coveredWithRig / intervals : 0.0)
        << " (" << coveredWithRig << fmt("); bootstrap and curvature only: %.0f %%", intervals ? 100.0 * coveredWithoutHalves / intervals : 0.0)
        << " (" << coveredWithoutHalves << ").\n";
+    // Pooled: each seed's own coverage, since the issue asks it of every study, not of the pool.
+    if (coverageByStudy.size() > 1) {
+        md << "\nBy study:";
+        const char* sep = " ";
+        for (const auto& [name, c] : coverageByStudy) {
+            md << sep << name << fmt(" %.0f %%", 100.0 * c.first / c.second) << " (" << c.first << " of " << c.second << ")";
+            summary["coverage_by_study"][name] = {{"covered", c.first}, {"intervals", c.second}};
+            sep = ", ";
+        }
+        md << ".\n";
+    }
     md << "\nModel discrepancy this study measures (standard deviation of found - true beyond the statistical and rig-unknown intervals; "
           "relative for r_A and zt_ratio; `rosin diagnose --model-discrepancy NAME=SD` takes it):";
     for (const auto& [p, e] : excess) {

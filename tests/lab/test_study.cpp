@@ -698,7 +698,7 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     writeSet(b, 0, truth(nothing, 21), residual(none, 9.25));
     writeSet(b, 1, truth({{"effects", {"hertzian_contact"}}, {"params", {{"load_exponent", 0.80}}}}, 22), none);
     writeSet(b, 2, truth({{"effects", {"hertzian_contact"}}, {"params", {{"load_exponent", 0.60}}}}, 23),
-             diagnosis(json::array({finding("hertzian_contact", "load_exponent", 0.62, 0.57, 0.66)})));
+             diagnosis(json::array({finding("hertzian_contact", "load_exponent", 0.62, 0.61, 0.66)}))); // misses 0.60
     std::ofstream(a / "plan.json") << json{{"grid", 12}, {"seed", 1}, {"sets", json::array()}}.dump();
     std::ofstream(b / "plan.json") << json{{"grid", 12}, {"seed", 2}, {"plan", 2}, {"sets", json::array()}}.dump();
 
@@ -711,6 +711,10 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     EXPECT_EQ(s["detection"]["hertzian_contact"]["hidden"], 3);
     EXPECT_EQ(s["detection"]["hertzian_contact"]["named"], 2);
     EXPECT_EQ(s["parameters"]["load_exponent"]["named"], 2);
+    // Coverage 1 of 2 pooled, and by study: a's interval holds its truth, b's misses.
+    EXPECT_EQ(s["coverage_by_study"][a.filename().string()], json({{"covered", 1}, {"intervals", 1}}));
+    EXPECT_EQ(s["coverage_by_study"][b.filename().string()], json({{"covered", 0}, {"intervals", 1}}));
+    EXPECT_NE(md.find("By study: " + a.filename().string() + " 100 % (1 of 1), " + b.filename().string() + " 0 % (0 of 1)."), std::string::npos) << md;
     EXPECT_DOUBLE_EQ(s["usual_residual_measured"].get<double>(), 9.25); // study b's null, not a's 6.5
     EXPECT_EQ(s["pooled_from"], json({a.filename().string(), b.filename().string()}));
     EXPECT_EQ(study["sets"][3]["study"], b.filename().string());
@@ -754,6 +758,7 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     json alone;
     std::ifstream(a / "study.json") >> alone;
     EXPECT_FALSE(alone["summary"].contains("pooled_from"));
+    EXPECT_FALSE(alone["summary"].contains("coverage_by_study")) << "one study has no per-study line";
     EXPECT_EQ(alone["sets"][0]["study"], "");
     for (const auto& d : {a, b, out}) fs::remove_all(d);
 }
