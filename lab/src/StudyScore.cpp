@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "DiagnoseEngine.h"
 #include "rosin/dsp/FrictionLaws.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Plot.h"
@@ -203,7 +204,7 @@ Scored readScored(const fs::path& f)
                 s.calibration[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
                 if (v.contains("ci95_curvature") && v["ci95_curvature"].size() == 2) {
                     s.calibrationCurvature[name] = {v["ci95_curvature"][0].get<double>(), v["ci95_curvature"][1].get<double>()};
-                } else if (name == "tension_scale" || name == "beta_scale" || name == "rod_effusivity_scale") {
+                } else if (diag::isNuisance(name)) {
                     // Fitted, but from a diagnosis before the widening: its interval is the curvature's.
                     s.calibrationCurvature[name] = {s.calibration[name][1], s.calibration[name][2]};
                     s.calibrationNotWidened.insert(name);
