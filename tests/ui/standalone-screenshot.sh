@@ -10,9 +10,16 @@ mkdir -p "$out"
 work="$(mktemp -d)"
 server="rosin-ui-$$"
 display=":$((90 + $$ % 100))"
+# Stop in order: the Standalone first, so it leaves JACK as a client should; then jackd, waited for,
+# so it can release its slot in the machine-wide JACK registry. Stopped all at once, each run leaked
+# a slot and its semaphores in /dev/shm, and after about eight runs jackd refused to start.
+stop() { [ -n "${1:-}" ] || return 0; kill "$1" 2>/dev/null || true; wait "$1" 2>/dev/null || true; }
 cleanup() {
-  kill "${app_pid:-}" "${xvfb_pid:-}" "${jack_pid:-}" 2>/dev/null || true
-  wait 2>/dev/null || true
+  stop "${app_pid:-}"
+  stop "${jack_pid:-}"
+  stop "${xvfb_pid:-}"
+  # Only a jackd that died on its own leaves these now; they are this run's server's alone.
+  rm -f /dev/shm/jack_sem.*_"$server"_* 2>/dev/null || true
   rm -rf "$work"
 }
 trap cleanup EXIT
