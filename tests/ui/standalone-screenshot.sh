@@ -54,7 +54,7 @@ for attempt in 1 2 3; do
   done
   [ "$jack_up" -eq 1 ] && break
   echo "jackd (attempt $attempt) did not answer:"; cat "$work/jack-$attempt.log"
-  kill "$jack_pid" 2>/dev/null || true; wait "$jack_pid" 2>/dev/null || true
+  stop "$jack_pid"
 done
 [ "$jack_up" -eq 1 ] || { echo "FAIL: no JACK server to test the Standalone on"; exit 1; }
 for _ in $(seq 100); do xdpyinfo >/dev/null 2>&1 && break; sleep 0.2; done
