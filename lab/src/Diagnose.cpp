@@ -66,16 +66,16 @@ const std::vector<std::string>& physicalParameterNames()
 using namespace diag;
 
 namespace {
-/// The model without one effect and its parameters (an effect takes the nuisances that matter
-/// only to it along: thermal memory the bow side's effusivity, torsion its wave speed).
+/// The model without one effect and its parameters (thermal memory takes the nuisances that
+/// matter only to a thermal model with it).
 EffectModel removed(EffectModel m, const std::string& effect)
 {
-    auto onlyWith = [&](const std::string& name) {
-        return std::any_of(nuisances().begin(), nuisances().end(), [&](const Nuisance& k) { return k.onlyWith == effect && k.name == name; });
+    auto thermalOnly = [](const std::string& name) {
+        return std::any_of(nuisances().begin(), nuisances().end(), [&](const Nuisance& k) { return k.thermalOnly && k.name == name; });
     };
     m.effects.erase(std::remove(m.effects.begin(), m.effects.end(), effect), m.effects.end());
     for (auto it = m.params.begin(); it != m.params.end();) {
-        const bool its = effectOfParameter(it->first) == effect || onlyWith(it->first);
+        const bool its = effectOfParameter(it->first) == effect || (effect == "thermal_memory" && thermalOnly(it->first));
         it = its ? m.params.erase(it) : std::next(it);
     }
     return m;
@@ -154,8 +154,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, tension within " + prior("tension_scale", info.tensionPrior) +
                    " and bow position within " + prior("beta_scale", info.betaPrior) +
                    " of the manifest, fitted on the fit strokes with the baseline model; effects are fitted on top of them. Once thermal memory "
-               "is tried, the bow side's thermal effusivity (0.65-1.35 x 450) is a nuisance too, and once torsion is tried the torsional wave "
-               "speed (4.5-6 times the transverse).",
+               "is tried, the bow side's thermal effusivity (0.65-1.35 x 450) is a nuisance too.",
                "An effect is fitted on the fit strokes and named only when (1) its validation-error fall is the largest of the round "
                "with a 95 % paired-bootstrap interval above 0, (2) the fall is at least " + std::to_string(static_cast<int>(std::lround(100 * o.namingThreshold))) +
                    " % of the validation error (threshold calibrated on null sets), and a candidate that brings thermal memory along "

@@ -36,9 +36,9 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
         c.start.push_back(value);
     }
     const bool calibrated = m.params.count("tension_scale") > 0; // the diagnosis fits nuisances at all
+    const bool thermal = has(m.effects, "thermal_memory") || has(c.adds, "thermal_memory");
     for (const Nuisance& k : nuisances()) {
-        const bool wanted = !k.onlyWith.empty() && (has(m.effects, k.onlyWith) || has(c.adds, k.onlyWith));
-        if (!m.params.count(k.name) && !(calibrated && wanted)) continue;
+        if (!m.params.count(k.name) && !(k.thermalOnly && calibrated && thermal)) continue;
         c.names.push_back(k.name);
         c.lo.push_back(parameterBounds().at(k.name).first);
         c.hi.push_back(parameterBounds().at(k.name).second);
@@ -46,31 +46,20 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
         // Thermal memory alone is the yardstick a rate dependence or a rosin shift must beat, and
         // those have a grid over two or three dimensions: searched over r_A alone, it would leave
         // the bow side's effusivity where it starts and lose to a shift standing in for it.
-        if (k.onlyWith == "thermal_memory" && c.effect == "thermal_memory") c.gridAlso.push_back(c.names.size() - 1);
+        if (k.thermalOnly && c.effect == "thermal_memory") c.gridAlso.push_back(c.names.size() - 1);
     }
     return c;
 }
-
-namespace {
-std::string ratioText(double x)
-{
-    char b[16];
-    std::snprintf(b, sizeof b, "%.1f", x);
-    return b;
-}
-} // namespace
 
 const std::vector<Nuisance>& nuisances()
 {
     // The rod's effusivity (how fast the bow hair draws heat from the contact) is a scale of the
     // model's own nominal value, so its meaning names that value.
     static const std::vector<Nuisance> list{
-        {"tension_scale", "true tension / manifest tension", ""},
-        {"beta_scale", "true bow position / manifest beta", ""},
+        {"tension_scale", "true tension / manifest tension"},
+        {"beta_scale", "true bow position / manifest beta"},
         {"rod_effusivity_scale",
-         "bow-side thermal effusivity / " + std::to_string(std::lround(dsp::ThermalParams{}.rodEffusivity)) + " W s^1/2 m^-2 K^-1",
-         "thermal_memory"},
-        {"torsion_speed_scale", "torsional wave speed / the model's " + ratioText(dsp::StringParams{}.torsionSpeedRatio) + " x the transverse", "torsional_compliance"}};
+         "bow-side thermal effusivity / " + std::to_string(std::lround(dsp::ThermalParams{}.rodEffusivity)) + " W s^1/2 m^-2 K^-1", true}};
     return list;
 }
 
@@ -168,10 +157,7 @@ const std::map<std::string, std::pair<double, double>>& parameterBounds()
                                                                       {"shift_k", {-30.0, 30.0}},   {"zt_ratio", {0.7, 8.0}},
                                                                       {"tension_scale", {0.95, 1.05}}, {"beta_scale", {0.96, 1.04}},
                                                                       // bow hair and rosin: 300-600 W s^1/2 m^-2 K^-1 (W03 Table I gives 450)
-                                                                      {"rod_effusivity_scale", {0.65, 1.35}},
-                                                                      // c_t / c: 5.2 for cello strings (Woodhouse), 4.5-6 as a lab that has
-                                                                      // not measured its string's torsional speed must allow
-                                                                      {"torsion_speed_scale", {4.5 / 5.2, 6.0 / 5.2}}};
+                                                                      {"rod_effusivity_scale", {0.65, 1.35}}};
     return b;
 }
 

@@ -147,7 +147,6 @@ dsp::BowedStringConfig Engine::config(const EffectModel& m) const
     c.string.tension = info_.tension * get("tension_scale");
     c.string.massPerLength = c.string.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
     c.friction.thermal.rodEffusivity *= get("rod_effusivity_scale");
-    c.string.torsionSpeedRatio *= get("torsion_speed_scale");
     c.friction.thermal.contactRadiusAtRef *= get("contact_radius_scale");
     return c;
 }

@@ -86,19 +86,15 @@ std::string noEffectValue(const std::string& name);
 /// True when the reported 95 % interval (statistical, rig unknowns and the studies' model
 /// discrepancy) stays clear of the no-effect value; parameters without one count as clear.
 bool clearOfNoEffect(const Finding& f, const std::string& name);
-/// The c_t / c the lab's models start from for a rolling string (5.2, a cello string's).
+/// The c_t / c the lab's models take for a rolling string (the data do not fix it).
 double assumedTorsionSpeedRatio();
-/// The c_t / c of model m: the assumed one times its fitted torsion_speed_scale, if it has one.
-double torsionSpeedRatioOf(const EffectModel& m);
-/// A rolling string's softening of the bow point (rollingSoftening) in the lab's model at this
-/// Z_t/Z_0 and c_t / c.
-double softeningAt(double ztRatio, double speedRatio = assumedTorsionSpeedRatio());
+/// A rolling string's softening of the bow point (rollingSoftening) in the lab's model at this Z_t/Z_0.
+double softeningAt(double ztRatio);
 /// A named torsion's softening at its value and at the ends of its reported Z_t/Z_0 interval.
-std::array<double, 3> rollingSofteningOf(const Finding& f, double speedRatio = assumedTorsionSpeedRatio());
+std::array<double, 3> rollingSofteningOf(const Finding& f);
 /// What a finding's numbers can and cannot say beyond its table, in plain words for report.md:
-/// a reported interval that reaches the no-effect value, and what a torsion's Z_t/Z_0 rests on
-/// (`speedRatio`: the c_t / c of the final model; `speedFitted`: a calibration fitted it).
-std::string findingCaveats(const Finding& f, double speedRatio = assumedTorsionSpeedRatio(), bool speedFitted = false);
+/// a reported interval that reaches the no-effect value, and what a torsion's Z_t/Z_0 rests on.
+std::string findingCaveats(const Finding& f);
 
 /// A finding's evidence in plain words: which part of the comparison the extension mended most.
 std::string describe(const std::string& effect, const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after,
@@ -116,9 +112,7 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
 struct Nuisance {
     std::string name;
     std::string meaning;     ///< what its value is, in the report's words
-    /// The effect it matters to alone (free once that effect is in the model or the candidate);
-    /// empty: every model.
-    std::string onlyWith;
+    bool thermalOnly = false; ///< matters only to a thermal model: free once thermal memory is in the model or the candidate
 };
 /// Every nuisance, in the order the fits append them.
 const std::vector<Nuisance>& nuisances();

@@ -194,26 +194,15 @@ bool clearOfNoEffect(const Finding& f, const std::string& name)
 
 double assumedTorsionSpeedRatio() { return modelWithEffects({"torsional_compliance"}, {}).string.torsionSpeedRatio; }
 
-double torsionSpeedRatioOf(const EffectModel& m)
-{
-    const auto k = m.params.find("torsion_speed_scale");
-    return assumedTorsionSpeedRatio() * (k == m.params.end() ? 1.0 : k->second);
-}
+double softeningAt(double ztRatio) { return rollingSoftening(modelWithEffects({"torsional_compliance"}, {{"zt_ratio", ztRatio}})); }
 
-double softeningAt(double ztRatio, double speedRatio)
-{
-    dsp::BowedStringConfig c = modelWithEffects({"torsional_compliance"}, {{"zt_ratio", ztRatio}});
-    c.string.torsionSpeedRatio = speedRatio;
-    return rollingSoftening(c);
-}
-
-std::array<double, 3> rollingSofteningOf(const Finding& f, double speedRatio)
+std::array<double, 3> rollingSofteningOf(const Finding& f)
 {
     const auto [lo, hi] = reportedInterval(f, "zt_ratio");
-    return {softeningAt(f.parameters.at("zt_ratio")[0], speedRatio), softeningAt(lo, speedRatio), softeningAt(hi, speedRatio)};
+    return {softeningAt(f.parameters.at("zt_ratio")[0]), softeningAt(lo), softeningAt(hi)};
 }
 
-std::string findingCaveats(const Finding& f, double speedRatio, bool speedFitted)
+std::string findingCaveats(const Finding& f)
 {
     std::string text;
     for (const auto& [name, v] : f.parameters) {
@@ -225,15 +214,13 @@ std::string findingCaveats(const Finding& f, double speedRatio, bool speedFitted
                 ") reaches its no-effect value, " + noEffectValue(name) + ": the data favour the effect without ruling out its absence. ";
     }
     if (f.parameters.count("zt_ratio")) {
-        const auto [s, low, high] = rollingSofteningOf(f, speedRatio);
-        const std::string speed = speedFitted ? "fitted as calibration within the 4.5-6 that strings measure: c_t = " + fmt(speedRatio, "%.2f") +
-                                                    " c here (the calibration table gives how little the data narrow it)"
-                                              : "taken as c_t = " + fmt(speedRatio, "%.2g") + " c; strings measure about 4.5-6";
+        const auto [s, low, high] = rollingSofteningOf(f);
         text += "What the ramps and first slips fix is how much softer the rolling string makes the bow point: a factor s = " +
                 fmt(s, "%.3f") + " (" + fmt(low, "%.3f") + " – " + fmt(high, "%.3f") +
-                "), the transverse stiffness in series with Z_t c_t against Z_0 c. Z_t/Z_0 follows from it with the torsional wave speed " +
-                speed + ", and Z_t/Z_0 moves in inverse proportion to c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0). The ramps "
-                "also trade s one for one with the rig's tension over bow position, which the fits know only within their priors. ";
+                "), the transverse stiffness in series with Z_t c_t against Z_0 c. Z_t/Z_0 follows from it with the torsional wave speed "
+                "taken as c_t = " + fmt(assumedTorsionSpeedRatio(), "%.2g") + " c; strings measure about 4.5-6, and Z_t/Z_0 moves in inverse proportion to "
+                "c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0). The ramps also trade s one for one with the rig's tension "
+                "over bow position, which the fits know only within their priors. ";
     }
     if (!text.empty()) text.pop_back();
     return text;
@@ -301,9 +288,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (!fs::is_directory(dir)) throw LabError(dir.string() + ": cannot create the output directory");
-    const double speedRatio = diag::torsionSpeedRatioOf(d.final);
-    const bool speedFitted = d.final.params.count("torsion_speed_scale") > 0;
-    auto findingJson = [&](const Finding& f) {
+    auto findingJson = [](const Finding& f) {
         json params = json::object();
         for (const auto& [name, v] : f.parameters) {
             const auto [lo, hi] = reportedInterval(f, name);
@@ -316,9 +301,8 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             params[name]["identified"] = !f.unidentified.count(name);
             if (!diag::noEffectValue(name).empty()) params[name]["clear_of_no_effect"] = diag::clearOfNoEffect(f, name);
             if (name == "zt_ratio") {
-                // the c_t / c its Z_t/Z_0 rests on: fitted as calibration, or the model's assumption
-                params[name][speedFitted ? "torsion_speed_ratio_fitted" : "torsion_speed_ratio_assumed"] = speedRatio;
-                const auto [s, low, high] = diag::rollingSofteningOf(f, speedRatio);
+                params[name]["torsion_speed_ratio_assumed"] = diag::assumedTorsionSpeedRatio();
+                const auto [s, low, high] = diag::rollingSofteningOf(f);
                 params[name]["rolling_softening"] = {{"value", s}, {"ci95", {low, high}}};
             }
         }
@@ -469,9 +453,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             md << "| " << name << " | " << fmt(v[0]) << " | " << fmt(lo) << " – " << fmt(hi) << " | " << fmt(v[1]) << " – " << fmt(v[2]) << " | "
                << range(f.curvature, name, " – ") << " | " << range(f.halves, name, " / ") << " | " << range(f.systematic, name, " / ") << " | " << (f.discrepancy.count(name) ? fmt(f.discrepancy.at(name)) : std::string("-")) << " |\n";
         }
-        if (const std::string caveats = diag::findingCaveats(f, diag::torsionSpeedRatioOf(d.final), d.final.params.count("torsion_speed_scale") > 0);
-            !caveats.empty())
-            md << "\n" << caveats << "\n";
+        if (const std::string caveats = diag::findingCaveats(f); !caveats.empty()) md << "\n" << caveats << "\n";
         for (const auto& name : f.unidentified)
             md << "\n" << name << " is not identified: the errors do not change along it at the fit (no curvature), so its "
                << "interval is its whole search range and its value is whatever the search stopped at.\n";

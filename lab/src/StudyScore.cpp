@@ -464,8 +464,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     // Nuisances: what the rig really was against what the diagnosis calibrated (not findings,
     // so not in the coverage above, but their intervals should mean what they say too).
     // Tension and bow position are 1 + the rig's relative error of the same quantity; the rod's
-    // effusivity is the rig's value over the model's nominal, which the diagnosis scales, and so
-    // is the torsional wave speed (its truth counts only where the rig's string rolls).
+    // effusivity is the rig's value over the model's nominal, which the diagnosis scales.
     struct RigSide {
         const char* nuisance;
         const char* rigKey;
@@ -474,7 +473,6 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     const RigSide nuisanceOfRig[]{{"tension_scale", "tension_error", 1.0, 1.0},
                                   {"beta_scale", "beta_error", 1.0, 1.0},
                                   {"rod_effusivity_scale", "rod_effusivity", 0.0, dsp::ThermalParams{}.rodEffusivity},
-                                  {"torsion_speed_scale", "torsion_speed_ratio", 0.0, diag::assumedTorsionSpeedRatio()},
                                   {"scale_n_per_unit", "scale_n_per_unit", 0.0, 1.0}};
     // Each fitted nuisance's discrepancy: the spread of (value - truth) beyond its curvature
     // interval, as for the findings' parameters (what `--model-discrepancy NAME=SD` takes).
@@ -486,7 +484,6 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         double excessSum = 0.0;
         for (const auto& s : sets) {
             if (!s.calibration.count(name) || !s.rig.count(rigKey)) continue;
-            if (std::string(name) == "torsion_speed_scale" && !has(s.hidden, "torsional_compliance")) continue;
             const double t = offset + s.rig.at(rigKey) / divisor;
             const auto& c = s.calibration.at(name);
             err.push_back(std::abs(c[0] / t - 1.0));

@@ -416,58 +416,6 @@ TEST(DiagnoseParameters, TheGridSpansOnlyParametersTheDataFix)
     EXPECT_EQ(diag::gridDimensions(m), (Dims{{0, 7}, {m.gridAlso[0], 3}}));
 }
 
-// A lab seldom knows its string's torsional wave speed (strings measure c_t/c 4.5-6, the model
-// takes 5.2): a torsion candidate fits it beside Z_t/Z_0 as calibration, within that range, and
-// no other candidate carries it. The voice takes it, and the softening the report gives with it.
-TEST(DiagnoseParameters, ATorsionCandidateFitsTheTorsionalWaveSpeedAsCalibration)
-{
-    EffectModel calibrated;
-    calibrated.params = {{"tension_scale", 1.0}, {"beta_scale", 1.0}};
-    const auto first = diag::candidates(calibrated);
-    for (const auto& c : first) {
-        const diag::Candidate with = diag::withNuisances(c, calibrated);
-        const bool carries = std::find(with.names.begin(), with.names.end(), "torsion_speed_scale") != with.names.end();
-        EXPECT_EQ(carries, c.effect == "torsional_compliance") << c.effect;
-        if (!carries) continue;
-        const auto k = static_cast<std::size_t>(std::find(with.names.begin(), with.names.end(), "torsion_speed_scale") - with.names.begin());
-        EXPECT_NEAR(with.lo[k] * diag::assumedTorsionSpeedRatio(), 4.5, 1e-9);
-        EXPECT_NEAR(with.hi[k] * diag::assumedTorsionSpeedRatio(), 6.0, 1e-9);
-        EXPECT_DOUBLE_EQ(with.start[k], 1.0);
-        EXPECT_TRUE(with.gridAlso.empty()) << "the grid stays over Z_t/Z_0: COBYLA moves the speed";
-        EXPECT_TRUE(diag::isNuisance("torsion_speed_scale"));
-    }
-    // Once torsion is named, every later fit keeps the speed free (it is in the model's params).
-    EffectModel rolling = calibrated;
-    rolling.effects = {"torsional_compliance"};
-    rolling.params["zt_ratio"] = 2.0;
-    rolling.params["torsion_speed_scale"] = 1.1;
-    const auto contact = offered(diag::candidates(rolling), "hertzian_contact");
-    ASSERT_TRUE(contact);
-    const diag::Candidate c = diag::withNuisances(*contact, rolling);
-    EXPECT_NE(std::find(c.names.begin(), c.names.end(), "torsion_speed_scale"), c.names.end());
-
-    // What the voice runs and what the report says both use it: 5.72 c at Z_t/Z_0 2.
-    diag::StringInfo info;
-    Diagnosis d;
-    std::vector<diag::Prepared> strokes = preparedModelSet({}, 31, info, d);
-    const diag::Engine engine(strokes, info, DiagnoseOptions{}.simRate, std::nullopt, false);
-    EXPECT_NEAR(engine.config(rolling).string.torsionSpeedRatio, 5.72, 1e-9);
-    EXPECT_NEAR(engine.config(calibrated).string.torsionSpeedRatio, 5.2, 1e-9);
-    EXPECT_NEAR(diag::rollingSoftening(engine.config(rolling)), diag::softeningAt(2.0, 5.72), 1e-12);
-    EXPECT_NEAR(diag::torsionSpeedRatioOf(rolling), 5.2 * 1.1, 1e-9);
-    EXPECT_NEAR(diag::torsionSpeedRatioOf(calibrated), 5.2, 1e-9);
-    EXPECT_NEAR(diag::softeningAt(2.0, 5.72), 1.0 / (1.0 + 1.0 / (2.0 * 5.72)), 1e-12);
-    Finding f;
-    f.effect = "torsional_compliance";
-    f.parameters["zt_ratio"] = {2.0, 1.9, 2.1};
-    const std::string fitted = diag::findingCaveats(f, 5.72, true), assumed = diag::findingCaveats(f);
-    EXPECT_NE(fitted.find("c_t = 5.72 c here"), std::string::npos) << fitted;
-    EXPECT_NE(assumed.find("taken as c_t = 5.2 c"), std::string::npos) << assumed;
-    char s[32];
-    std::snprintf(s, sizeof s, "s = %.3f", diag::softeningAt(2.0, 5.72));
-    EXPECT_NE(fitted.find(s), std::string::npos) << fitted;
-}
-
 // Rule 2's comparisons with the round's other candidates, in their order, with the shares written
 // into the trial.
 TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneAndWithEachOther)

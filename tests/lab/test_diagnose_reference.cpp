@@ -353,20 +353,6 @@ TEST(DiagnoseReference, FindsAStronglyRollingStringAndTakesItsSofteningOutOfTheS
     for (const auto& c : o.d.calibration)
         if (c.name == "scale_n_per_unit") scale = c.value;
     EXPECT_NEAR(scale * o.truth.gain, 1.0, 0.03);
-    // The torsional wave speed is calibrated beside the roll. This rig's 4.5 c sits at the edge of
-    // what strings measure, which the fit leaves near the model's 5.2 c: the reported interval holds
-    // it because it adds the prior's own spread to the curvature's, which alone is narrower.
-    const double speed = o.truth.rig.at("torsion_speed_ratio") / diag::assumedTorsionSpeedRatio();
-    int calibrated = 0;
-    for (const auto& c : o.d.calibration) {
-        if (c.name != "torsion_speed_scale") continue;
-        ++calibrated;
-        EXPECT_LE(c.low, speed);
-        EXPECT_GE(c.high, speed);
-        EXPECT_LT(c.curvature[1] - c.curvature[0], c.high - c.low);
-        EXPECT_NE(c.meaning.find("do not narrow its prior"), std::string::npos) << c.meaning;
-    }
-    EXPECT_EQ(calibrated, 1);
 }
 
 // The same set diagnosed with three splits: torsion alone named and the scale within 3 % on each,
@@ -393,9 +379,8 @@ TEST(DiagnoseReferenceLong, ARollingStringsZtIsWithinTwentyPercentOnTheMedianOfT
     EXPECT_GE(covered, 2);
 }
 
-// Issue 20's open targets: these fail on today's diagnosis (torsion at Z_t/Z_0 = 1.6 is named
-// but at 1.21, 24 % low, with the torsional speed calibrated, 1.10 without; a -14 K rosin shift
-// comes out near -20 K), so they run with the `long` label, not in CI.
+// Issue 20's open targets: these fail on today's diagnosis (torsion at Z_t/Z_0 = 1.6 is not
+// named; a -14 K rosin shift comes out near -20 K), so they run with the `long` label, not in CI.
 TEST(DiagnoseReferenceLong, FindsTorsion) { expectDiagnosis(run({"torsional_compliance"}, {{"zt_ratio", 1.6}}, 44)); }
 
 // The same quiet rig as the strongly rolling string above, with thermal memory beside the roll

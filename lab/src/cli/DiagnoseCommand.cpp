@@ -88,7 +88,7 @@ struct DiagnoseCommand {
             const bool nuisance = diagOptions.calibrationDiscrepancy.count(name) > 0;
             if ((effectOfParameter(name) == "calibration" && !nuisance) || !std::isfinite(sd) || sd < 0.0 || sd > 10.0) // neither a finding's parameter nor a nuisance
                 throw LabError("--model-discrepancy " + item + ": expected NAME=SD with NAME one of r_A, h0, p, load_exponent, shift_k, zt_ratio, "
-                               "tension_scale, beta_scale, rod_effusivity_scale, torsion_speed_scale and SD from 0 to 10");
+                               "tension_scale, beta_scale, rod_effusivity_scale and SD from 0 to 10");
             (nuisance ? diagOptions.calibrationDiscrepancy : diagOptions.modelDiscrepancy)[name] = sd;
         }
         if (fs::exists(diagOut)) throw LabError(diagOut + ": already exists (choose a new folder)");
