@@ -379,8 +379,9 @@ TEST(DiagnoseReferenceLong, ARollingStringsZtIsWithinTwentyPercentOnTheMedianOfT
     EXPECT_GE(covered, 2);
 }
 
-// Issue 20's open targets: these fail on today's diagnosis (torsion at Z_t/Z_0 = 1.6 is not
-// named; a -14 K rosin shift comes out near -20 K), so they run with the `long` label, not in CI.
+// Issue 20's open targets: these fail on today's diagnosis (torsion at Z_t/Z_0 = 1.6 is named
+// but at 1.10, 31 % low; a -14 K rosin shift comes out near -20 K), so they run with the `long`
+// label, not in CI.
 TEST(DiagnoseReferenceLong, FindsTorsion) { expectDiagnosis(run({"torsional_compliance"}, {{"zt_ratio", 1.6}}, 44)); }
 
 // The same quiet rig as the strongly rolling string above, with thermal memory beside the roll
