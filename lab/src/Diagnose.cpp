@@ -171,6 +171,11 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                "After each new finding every earlier one must still earn its place: the model is refitted without it, and an effect whose "
                "absence raises the validation error by less than the naming threshold is dropped and not tried again.",
                "The reported gain compares the calibrated baseline and the final model on the test strokes only."};
+    if (o.tryPairs)
+        d.rules.push_back("When a round names nothing, a Hertzian contact and a rolling string still open are tried together as one candidate "
+                          "(one r_A), from the grid and from where their own fits that round left them; the pair names both only when its "
+                          "validation error is also below each of the two alone, fitted in that round, by the naming threshold, and rules 2-5 "
+                          "hold for all its parameters.");
     if (o.usualResidualRatio > 0.0) d.rules.push_back(standInRuleText(o.usualResidualRatio));
 
     // 4. From the calibrated baseline, add effects one round at a time.
@@ -231,22 +236,22 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         std::map<std::string, std::array<double, 2>> halvesOffset; // the named candidate's halves, from its value
         std::map<std::string, double> roundValidation;               // every candidate's validation error this round
         for (const Tried& t : tried) roundValidation[t.c.effect] = mean(t.val);
-        for (const Tried& t : tried) {
+        // Rules 2-5 for a candidate whose validation fall passed rule 1; the verdict goes on its trial.
+        auto judge = [&](const Tried& t) {
             Trial& trial = d.trials[t.trial];
-            if (!(t.gain[1] > 0.0) || trial.relativeGain < o.namingThreshold) continue;
             std::map<std::string, double> fitted;
             for (std::size_t j = 0; j < t.c.names.size(); ++j) fitted[t.c.names[j]] = t.x[j];
-            if (atNull(t.c.effect, fitted)) { trial.verdict = "fitted at the effect's own absence"; continue; }
-            if (pinnedAtEdge(t.c, t.x)) { trial.verdict = "fitted at the edge of its search range (a stand-in, not a measurement)"; continue; }
+            if (atNull(t.c.effect, fitted)) { trial.verdict = "fitted at the effect's own absence"; return false; }
+            if (pinnedAtEdge(t.c, t.x)) { trial.verdict = "fitted at the edge of its search range (a stand-in, not a measurement)"; return false; }
             // Rule 2's comparisons with the round's other candidates (docs/diagnosis.md).
             if (const std::string failed = standInVerdict(trial, t.c, roundValidation, current.effects, d.trials, o.namingThreshold, o.shiftOverRateMargin); !failed.empty()) {
                 trial.verdict = failed;
-                continue;
+                return false;
             }
             // (3) the test strokes
             const EffectModel cand = apply(current, t.c, t.x);
             trial.testGain = mean(currentTest) - mean(engine.errors(cand, testSet));
-            if (!(trial.testGain > 0.0)) { trial.verdict = "no gain on the test strokes"; continue; }
+            if (!(trial.testGain > 0.0)) { trial.verdict = "no gain on the test strokes"; return false; }
             // (4) intervals from refits on bootstrap resamples, each from a fresh start
             say("round " + std::to_string(round) + ": uncertainty of " + t.c.effect, 0.0);
             std::vector<std::vector<double>> refits;
@@ -293,20 +298,75 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 const double wide = namingHalfWidth(o, t.c.names[k], t.x[k], hw);
                 atNullWithDiscrepancy = atNullWithDiscrepancy || intervalAtNull(t.c.names[k], t.x[k] - wide, t.x[k] + wide);
             }
-            if (atNullInterval) { trial.verdict = "interval reaches the no-effect value"; continue; }
-            if (atNullWithDiscrepancy) { trial.verdict = "interval reaches the no-effect value once the model discrepancy is counted"; continue; }
+            if (atNullInterval) { trial.verdict = "interval reaches the no-effect value"; return false; }
+            if (atNullWithDiscrepancy) { trial.verdict = "interval reaches the no-effect value once the model discrepancy is counted"; return false; }
             // (5) the two force halves of the fit strokes
             std::vector<std::vector<double>> halves;
             for (bool high : {false, true})
                 halves.push_back(diag::fit(engine, current, t.c, subset(fitSet, strokes, high), t.x, std::max(8, o.maxEvaluations / 2), 0.1, nullptr, false));
             if (!halvesConsistent(t.c, halves[0], halves[1], halfWidth)) {
                 trial.verdict = "not consistent on the two drive halves (bow acceleration, or the gesture's own drive)";
-                continue;
+                return false;
             }
             trial.verdict = "named";
             for (std::size_t k = 0; k < t.c.scanned; ++k) halvesOffset[t.c.names[k]] = {halves[0][k] - t.x[k], halves[1][k] - t.x[k]};
-            best = &t;
-            break;
+            return true;
+        };
+        for (const Tried& t : tried) {
+            const Trial& trial = d.trials[t.trial];
+            if (!(t.gain[1] > 0.0) || trial.relativeGain < o.namingThreshold) continue;
+            if (judge(t)) {
+                best = &t;
+                break;
+            }
+        }
+        // Two effects that each fit worse alone than together (a roll beside a contact) are out of
+        // reach of rounds of single effects: when this round names nothing, each open pair is tried
+        // as one candidate, from the grid and from where its two effects' own fits left them.
+        std::vector<Tried> pairs;
+        pairs.reserve(pairedEffects().size());
+        for (const auto& [a, b] : o.tryPairs && !best ? pairedEffects() : std::vector<std::pair<std::string, std::string>>{}) {
+            const auto raw = offered(current, a + "+" + b);
+            if (!raw || dropped.count(a) || dropped.count(b) || !roundValidation.count(a) || !roundValidation.count(b)) continue;
+            Candidate c = withNuisances(*raw, current);
+            say("round " + std::to_string(round) + ": " + c.effect, 0.0);
+            double fitError = 0.0;
+            std::vector<double> x = diag::fit(engine, current, c, fitSet, c.start, 2 * o.maxEvaluations, 0.2, &fitError);
+            std::vector<double> warm = c.start;
+            for (const Tried& single : tried)
+                if (single.c.effect == a || single.c.effect == b)
+                    for (std::size_t k = 0; k < single.c.names.size(); ++k) {
+                        const auto at = std::find(c.names.begin(), c.names.end(), single.c.names[k]);
+                        // each effect's own parameters from its own fit; shared ones from the first (a)
+                        if (at != c.names.end() && (effectOfParameter(*at) == single.c.effect || single.c.effect == a))
+                            warm[static_cast<std::size_t>(at - c.names.begin())] = single.x[k];
+                    }
+            double warmError = 0.0;
+            std::vector<double> fromSingles = diag::fit(engine, current, c, fitSet, warm, 2 * o.maxEvaluations, 0.2, &warmError, false);
+            if (warmError < fitError) x = std::move(fromSingles), fitError = warmError;
+            Tried t{c, x, engine.errors(apply(current, c, x), valSet), {}, d.trials.size()};
+            t.gain = pairedGain(currentVal, t.val, o.bootstrap, o.seed + static_cast<std::uint64_t>(round * 100 + 50));
+            Trial trial;
+            trial.round = round;
+            trial.effect = c.effect;
+            for (std::size_t j = 0; j < c.names.size(); ++j) trial.parameters[c.names[j]] = x[j];
+            trial.fitError = fitError;
+            trial.gain = t.gain[0];
+            trial.gainLow = t.gain[1];
+            trial.gainHigh = t.gain[2];
+            trial.relativeGain = valBefore > 0 ? t.gain[0] / valBefore : 0.0;
+            const double pairVal = mean(t.val), overA = relativeFall(roundValidation.at(a), pairVal), overB = relativeFall(roundValidation.at(b), pairVal);
+            bool open = false;
+            if (!(t.gain[1] > 0.0)) trial.verdict = "validation fall not significant";
+            else if (trial.relativeGain < o.namingThreshold) trial.verdict = "validation fall below the threshold";
+            else if (std::min(overA, overB) < o.namingThreshold) trial.verdict = "no better than " + (overA < overB ? a : b) + " alone";
+            else open = true;
+            d.trials.push_back(trial);
+            pairs.push_back(std::move(t));
+            if (open && judge(pairs.back())) {
+                best = &pairs.back();
+                break;
+            }
         }
         if (!best) break;
         d.trials[best->trial].kept = true;
@@ -358,9 +418,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 // refit from where the earlier effect left the other parameters stays there). The
                 // winner is new this round, so the model without the earlier effect offers it.
                 const EffectModel before = removed(earlier, effect);
-                const std::vector<Candidate> again = candidates(before);
-                const auto winner = std::find_if(again.begin(), again.end(), [&](const Candidate& c) { return c.effect == best->c.effect; });
-                if (winner == again.end()) continue;
+                const auto winner = offered(before, best->c.effect);
+                if (!winner) continue;
                 const Candidate c = withNuisances(*winner, before);
                 Without w{effect, apply(before, c, diag::fit(engine, before, c, fitSet, c.start, o.maxEvaluations, 0.2)), {}, 0.0};
                 w.val = engine.errors(w.model, valSet);

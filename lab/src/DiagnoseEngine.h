@@ -171,7 +171,16 @@ Candidate withNuisances(Candidate c, const EffectModel& m);
 bool needsThermal(const std::string& effect);
 /// The extensions not yet in m (those that need thermal memory bring it along).
 std::vector<Candidate> candidates(const EffectModel& m);
-/// True when the fitted parameters put the effect at its own absence.
+/// The effects of a candidate's name: one, or two joined by '+' (a pair tried together).
+std::vector<std::string> membersOf(const std::string& effect);
+/// The pairs of effects tried together when a round names nothing (DiagnoseOptions::tryPairs).
+const std::vector<std::pair<std::string, std::string>>& pairedEffects();
+/// One candidate adding both: a's parameters, then b's that a lacks (a shared r_A once).
+Candidate together(const Candidate& a, const Candidate& b);
+/// The candidate candidates(m) offers under this name, a pair "a+b" built by together(); none
+/// when m already has one of its effects.
+std::optional<Candidate> offered(const EffectModel& m, const std::string& effect);
+/// True when the fitted parameters put the effect at its own absence (a pair: either effect).
 bool atNull(const std::string& effect, const std::map<std::string, double>& p);
 /// True when one of the candidate's own identifiable parameters ends within 1 % of its search
 /// range's edge (rule 2's edge condition: a stand-in pushed past what the candidate can express). h0 is not asked:

@@ -416,6 +416,55 @@ TEST(DiagnoseParameters, TheGridSpansOnlyParametersTheDataFix)
     EXPECT_EQ(diag::gridDimensions(m), (Dims{{0, 7}, {m.gridAlso[0], 3}}));
 }
 
+// A contact and a roll tried together (seed 2056's set 36: the roll alone fitted worse than no
+// effect, the pair a third better than the contact alone): one candidate adding both, with the
+// r_A both span once, a grid of three points on each of its three parameters, and at its own
+// absence when either effect is.
+TEST(DiagnoseParameters, AContactAndARollTriedTogetherShareOneRAAndAreAbsentWhenEitherIs)
+{
+    const std::string pair = "hertzian_contact+torsional_compliance";
+    ASSERT_EQ(diag::pairedEffects().size(), 1u);
+    EXPECT_EQ(diag::pairedEffects().front().first + "+" + diag::pairedEffects().front().second, pair);
+    EXPECT_EQ(diag::membersOf(pair), (std::vector<std::string>{"hertzian_contact", "torsional_compliance"}));
+    EXPECT_EQ(diag::membersOf("thermal_memory"), (std::vector<std::string>{"thermal_memory"}));
+
+    EffectModel thermal;
+    thermal.effects = {"thermal_memory"};
+    thermal.params = {{"r_A", 1.1}, {"tension_scale", 1.0}, {"beta_scale", 1.0}, {"rod_effusivity_scale", 1.0}};
+    const auto both = diag::offered(thermal, pair);
+    ASSERT_TRUE(both);
+    EXPECT_EQ(both->effect, pair);
+    EXPECT_EQ(both->adds, (std::vector<std::string>{"hertzian_contact", "torsional_compliance"}));
+    EXPECT_EQ(both->names, (std::vector<std::string>{"load_exponent", "r_A", "zt_ratio"}));
+    EXPECT_EQ(both->start, (std::vector<double>{0.8, 1.1, 2.0}));
+    EXPECT_DOUBLE_EQ(both->lo[2], 0.7);
+    EXPECT_DOUBLE_EQ(both->hi[2], 8.0);
+    const diag::Candidate c = diag::withNuisances(*both, thermal);
+    EXPECT_EQ(c.scanned, 3u);
+    using Dims = std::vector<std::pair<std::size_t, int>>;
+    EXPECT_EQ(diag::gridDimensions(c), (Dims{{0, 3}, {1, 3}, {2, 3}}));
+    // before thermal memory: no r_A, two parameters of five points each
+    const auto bare = diag::offered(EffectModel{}, pair);
+    ASSERT_TRUE(bare);
+    EXPECT_EQ(bare->names, (std::vector<std::string>{"load_exponent", "zt_ratio"}));
+    EXPECT_EQ(diag::gridDimensions(*bare), (Dims{{0, 5}, {1, 5}}));
+    // once either is named the pair is not offered
+    EffectModel contact = thermal;
+    contact.effects.push_back("hertzian_contact");
+    contact.params["load_exponent"] = 0.8;
+    EXPECT_FALSE(diag::offered(contact, pair).has_value());
+    EXPECT_TRUE(diag::offered(contact, "torsional_compliance").has_value());
+
+    EXPECT_FALSE(diag::atNull(pair, {{"load_exponent", 0.82}, {"zt_ratio", 1.5}}));
+    EXPECT_TRUE(diag::atNull(pair, {{"load_exponent", 0.98}, {"zt_ratio", 1.5}})); // Amontons
+    EXPECT_TRUE(diag::atNull(pair, {{"load_exponent", 0.82}, {"zt_ratio", 7.4}})); // no roll
+    std::vector<double> x(c.names.size(), 1.0);
+    x[0] = 0.8, x[1] = 1.1, x[2] = 8.0 - 0.05; // Z_t/Z_0 within 1 % of its range from the top
+    EXPECT_TRUE(diag::pinnedAtEdge(c, x));
+    x[2] = 3.0;
+    EXPECT_FALSE(diag::pinnedAtEdge(c, x));
+}
+
 // Rule 2's comparisons with the round's other candidates, in their order, with the shares written
 // into the trial.
 TEST(DiagnoseParameters, RuleTwoComparesARateLawAndAShiftWithThermalMemoryAloneAndWithEachOther)

@@ -75,6 +75,10 @@ struct DiagnoseOptions {
     /// than the model's bends the fitted thermal law as a +22 to +25 K shift does, by 0.08-0.29,
     /// where true shifts won by 0.32-0.77 (docs/diagnosis-study.md). 0 = the threshold alone.
     double shiftOverRateMargin = 0.3;
+    /// When a round names nothing, try the pairs of pairedEffects() still open as one candidate,
+    /// named only when it also beats each of its two effects alone by the naming threshold (a
+    /// rolling string beside a contact can fit worse alone than no effect: docs/diagnosis.md).
+    bool tryPairs = false;
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     /// The model's own error on rigs it does not describe (their thermal constants, an unnamed
     /// torsion): the standard deviation that a finding's parameter still misses the truth by
