@@ -196,29 +196,15 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         };
         std::vector<Tried> tried;
         const double valBefore = mean(currentVal);
-        for (std::size_t k = 0; k < cands.size(); ++k) {
-            say("round " + std::to_string(round) + ": " + cands[k].effect, static_cast<double>(k) / static_cast<double>(cands.size()));
-            double fitError = 0;
-            Tried t{cands[k], diag::fit(engine, current, cands[k], fitSet, cands[k].start, o.maxEvaluations, 0.2, &fitError), {}, {}, d.trials.size()};
-            // A rolling string changes the scale of every force the ramps read, so the parameters
-            // named without it sit far from where they belong beside it, and the grid from there
-            // misses the valley: search also from where round 1 left the torsion on the baseline,
-            // with twice the evaluations (COBYLA spends one per parameter, seven or more here,
-            // before its first step).
-            if (const auto from = roundOneStart(d.trials, cands[k]); round > 1 && from) {
-                double warmError = 0.0;
-                std::vector<double> warm = diag::fit(engine, current, cands[k], fitSet, *from, 2 * o.maxEvaluations, 0.2, &warmError, false);
-                if (warmError < fitError) {
-                    t.x = std::move(warm);
-                    fitError = warmError;
-                }
-            }
-            t.val = engine.errors(apply(current, t.c, t.x), valSet);
-            t.gain = pairedGain(currentVal, t.val, o.bootstrap, o.seed + static_cast<std::uint64_t>(round * 100 + static_cast<int>(k)));
+        // The candidate's validation errors, its paired gain and its trial row with rule 1's verdict.
+        auto evaluate = [&](const Candidate& c, std::vector<double> x, double fitError, std::uint64_t split) {
+            Tried t{c, std::move(x), {}, {}, d.trials.size()};
+            t.val = engine.errors(apply(current, c, t.x), valSet);
+            t.gain = pairedGain(currentVal, t.val, o.bootstrap, o.seed + split);
             Trial trial;
             trial.round = round;
-            trial.effect = t.c.effect;
-            for (std::size_t j = 0; j < t.c.names.size(); ++j) trial.parameters[t.c.names[j]] = t.x[j];
+            trial.effect = c.effect;
+            for (std::size_t j = 0; j < c.names.size(); ++j) trial.parameters[c.names[j]] = t.x[j];
             trial.fitError = fitError;
             trial.gain = t.gain[0];
             trial.gainLow = t.gain[1];
@@ -228,7 +214,27 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             if (!(t.gain[1] > 0.0)) trial.verdict = "validation fall not significant";
             else if (trial.relativeGain < o.namingThreshold) trial.verdict = "validation fall below the threshold";
             d.trials.push_back(trial);
-            tried.push_back(std::move(t));
+            return t;
+        };
+        auto passesRuleOne = [&](const Tried& t) { return t.gain[1] > 0.0 && d.trials[t.trial].relativeGain >= o.namingThreshold; };
+        for (std::size_t k = 0; k < cands.size(); ++k) {
+            say("round " + std::to_string(round) + ": " + cands[k].effect, static_cast<double>(k) / static_cast<double>(cands.size()));
+            double fitError = 0;
+            std::vector<double> x = diag::fit(engine, current, cands[k], fitSet, cands[k].start, o.maxEvaluations, 0.2, &fitError);
+            // A rolling string changes the scale of every force the ramps read, so the parameters
+            // named without it sit far from where they belong beside it, and the grid from there
+            // misses the valley: search also from where round 1 left the torsion on the baseline,
+            // with twice the evaluations (COBYLA spends one per parameter, seven or more here,
+            // before its first step).
+            if (const auto from = roundOneStart(d.trials, cands[k]); round > 1 && from) {
+                double warmError = 0.0;
+                std::vector<double> warm = diag::fit(engine, current, cands[k], fitSet, *from, 2 * o.maxEvaluations, 0.2, &warmError, false);
+                if (warmError < fitError) {
+                    x = std::move(warm);
+                    fitError = warmError;
+                }
+            }
+            tried.push_back(evaluate(cands[k], std::move(x), fitError, static_cast<std::uint64_t>(round * 100 + static_cast<int>(k))));
         }
         std::sort(tried.begin(), tried.end(), [](const Tried& a, const Tried& b) { return a.gain[0] > b.gain[0]; });
         const Tried* best = nullptr;
@@ -312,62 +318,45 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             for (std::size_t k = 0; k < t.c.scanned; ++k) halvesOffset[t.c.names[k]] = {halves[0][k] - t.x[k], halves[1][k] - t.x[k]};
             return true;
         };
-        for (const Tried& t : tried) {
-            const Trial& trial = d.trials[t.trial];
-            if (!(t.gain[1] > 0.0) || trial.relativeGain < o.namingThreshold) continue;
-            if (judge(t)) {
+        for (const Tried& t : tried)
+            if (passesRuleOne(t) && judge(t)) {
                 best = &t;
                 break;
             }
-        }
         // Two effects that each fit worse alone than together (a roll beside a contact) are out of
         // reach of rounds of single effects: when this round names nothing, each open pair is tried
         // as one candidate, from the grid and from where its two effects' own fits left them.
         std::vector<Tried> pairs;
         pairs.reserve(pairedEffects().size());
-        for (const auto& [a, b] : o.tryPairs && !best ? pairedEffects() : std::vector<std::pair<std::string, std::string>>{}) {
-            const auto raw = offered(current, a + "+" + b);
-            if (!raw || dropped.count(a) || dropped.count(b) || !roundValidation.count(a) || !roundValidation.count(b)) continue;
-            Candidate c = withNuisances(*raw, current);
-            say("round " + std::to_string(round) + ": " + c.effect, 0.0);
-            double fitError = 0.0;
-            std::vector<double> x = diag::fit(engine, current, c, fitSet, c.start, 2 * o.maxEvaluations, 0.2, &fitError);
-            std::vector<double> warm = c.start;
-            for (const Tried& single : tried)
-                if (single.c.effect == a || single.c.effect == b)
-                    for (std::size_t k = 0; k < single.c.names.size(); ++k) {
-                        const auto at = std::find(c.names.begin(), c.names.end(), single.c.names[k]);
-                        // each effect's own parameters from its own fit; shared ones from the first (a)
-                        if (at != c.names.end() && (effectOfParameter(*at) == single.c.effect || single.c.effect == a))
-                            warm[static_cast<std::size_t>(at - c.names.begin())] = single.x[k];
-                    }
-            double warmError = 0.0;
-            std::vector<double> fromSingles = diag::fit(engine, current, c, fitSet, warm, 2 * o.maxEvaluations, 0.2, &warmError, false);
-            if (warmError < fitError) x = std::move(fromSingles), fitError = warmError;
-            Tried t{c, x, engine.errors(apply(current, c, x), valSet), {}, d.trials.size()};
-            t.gain = pairedGain(currentVal, t.val, o.bootstrap, o.seed + static_cast<std::uint64_t>(round * 100 + 50));
-            Trial trial;
-            trial.round = round;
-            trial.effect = c.effect;
-            for (std::size_t j = 0; j < c.names.size(); ++j) trial.parameters[c.names[j]] = x[j];
-            trial.fitError = fitError;
-            trial.gain = t.gain[0];
-            trial.gainLow = t.gain[1];
-            trial.gainHigh = t.gain[2];
-            trial.relativeGain = valBefore > 0 ? t.gain[0] / valBefore : 0.0;
-            const double pairVal = mean(t.val), overA = relativeFall(roundValidation.at(a), pairVal), overB = relativeFall(roundValidation.at(b), pairVal);
-            bool open = false;
-            if (!(t.gain[1] > 0.0)) trial.verdict = "validation fall not significant";
-            else if (trial.relativeGain < o.namingThreshold) trial.verdict = "validation fall below the threshold";
-            else if (std::min(overA, overB) < o.namingThreshold) trial.verdict = "no better than " + (overA < overB ? a : b) + " alone";
-            else open = true;
-            d.trials.push_back(trial);
-            pairs.push_back(std::move(t));
-            if (open && judge(pairs.back())) {
-                best = &pairs.back();
-                break;
+        if (o.tryPairs && !best)
+            for (const auto& [a, b] : pairedEffects()) {
+                const auto raw = offered(current, a + "+" + b);
+                auto single = [&](const std::string& effect) {
+                    return std::find_if(tried.begin(), tried.end(), [&](const Tried& t) { return t.c.effect == effect; });
+                };
+                const auto alone = single(a), other = single(b);
+                if (!raw || alone == tried.end() || other == tried.end()) continue;
+                const Candidate c = withNuisances(*raw, current);
+                say("round " + std::to_string(round) + ": " + c.effect, 0.0);
+                double fitError = 0.0, warmError = 0.0;
+                std::vector<double> x = diag::fit(engine, current, c, fitSet, c.start, 2 * o.maxEvaluations, 0.2, &fitError);
+                std::vector<double> warm = diag::fit(engine, current, c, fitSet, startFromParts(c, alone->c, alone->x, other->c, other->x),
+                                                     2 * o.maxEvaluations, 0.2, &warmError, false);
+                if (warmError < fitError) x = std::move(warm), fitError = warmError;
+                pairs.push_back(evaluate(c, std::move(x), fitError, static_cast<std::uint64_t>(round * 100 + 50)));
+                const Tried& t = pairs.back();
+                Trial& trial = d.trials[t.trial];
+                const double overA = relativeFall(mean(alone->val), mean(t.val)), overB = relativeFall(mean(other->val), mean(t.val));
+                if (!passesRuleOne(t)) continue;
+                if (std::min(overA, overB) < o.namingThreshold) {
+                    trial.verdict = "no better than " + (overA < overB ? a : b) + " alone";
+                    continue;
+                }
+                if (judge(t)) {
+                    best = &t;
+                    break;
+                }
             }
-        }
         if (!best) break;
         d.trials[best->trial].kept = true;
         const double before = mean(currentVal);

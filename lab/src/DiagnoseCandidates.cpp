@@ -187,6 +187,21 @@ Candidate together(const Candidate& a, const Candidate& b)
     return c;
 }
 
+std::vector<double> startFromParts(const Candidate& pair, const Candidate& a, const std::vector<double>& xa, const Candidate& b,
+                                   const std::vector<double>& xb)
+{
+    std::vector<double> start = pair.start;
+    auto take = [&](const Candidate& part, const std::vector<double>& x, bool all) {
+        for (std::size_t k = 0; k < part.names.size(); ++k) {
+            const auto at = std::find(pair.names.begin(), pair.names.end(), part.names[k]);
+            if (at != pair.names.end() && (all || effectOfParameter(*at) == part.effect)) start[static_cast<std::size_t>(at - pair.names.begin())] = x[k];
+        }
+    };
+    take(a, xa, true);
+    take(b, xb, false);
+    return start;
+}
+
 std::optional<Candidate> offered(const EffectModel& m, const std::string& effect)
 {
     const std::vector<Candidate> all = candidates(m);

@@ -177,6 +177,10 @@ std::vector<std::string> membersOf(const std::string& effect);
 const std::vector<std::pair<std::string, std::string>>& pairedEffects();
 /// One candidate adding both: a's parameters, then b's that a lacks (a shared r_A once).
 Candidate together(const Candidate& a, const Candidate& b);
+/// Where a pair's search starts from its two effects' own fits: everything a's fit has (the
+/// shared r_A and the nuisances included), then b's own parameters from b's fit.
+std::vector<double> startFromParts(const Candidate& pair, const Candidate& a, const std::vector<double>& xa, const Candidate& b,
+                                   const std::vector<double>& xb);
 /// The candidate candidates(m) offers under this name, a pair "a+b" built by together(); none
 /// when m already has one of its effects.
 std::optional<Candidate> offered(const EffectModel& m, const std::string& effect);
