@@ -31,14 +31,24 @@ struct Outcome {
     SynthTruth truth;
 };
 
+/// The set the spec makes, written to files and read back as a user's set is (in newtons a stroke
+/// passes 1.0, a PCM file's full scale, so those are float files).
+MeasurementSet throughFiles(const SynthSpec& spec, SynthTruth& truth)
+{
+    const fs::path dir = fs::temp_directory_path() / ("rosin-diagref-" + std::to_string(::getpid()) + "-" + std::to_string(spec.seed));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    writeMeasurementSet(dir / "set", synthesize(spec, truth), spec.units == "N" ? SF_FORMAT_FLOAT : SF_FORMAT_PCM_24);
+    MeasurementSet set = readMeasurementSet(dir / "set");
+    fs::remove_all(dir);
+    return set;
+}
+
 /// The set, diagnosed once per split seed (one simulation, several fit/validation/test splits).
 std::vector<Outcome> runSplits(const std::vector<std::string>& effects, const std::map<std::string, double>& params, std::uint64_t seed,
                                const std::vector<std::uint64_t>& splitSeeds, int grid = 8, const std::string& gesture = "guettler",
                                const std::string& units = "V", const std::map<std::string, double>& rig = {})
 {
-    const fs::path dir = fs::temp_directory_path() / ("rosin-diagref-" + std::to_string(::getpid()) + "-" + std::to_string(seed));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
     SynthSpec spec;
     spec.generator = "reference";
     spec.effects = effects;
@@ -50,15 +60,13 @@ std::vector<Outcome> runSplits(const std::vector<std::string>& effects, const st
     spec.units = units;
     spec.rig = rig;
     SynthTruth truth;
-    // In newtons a stroke passes 1.0, a PCM file's full scale.
-    writeMeasurementSet(dir / "set", synthesize(spec, truth), units == "N" ? SF_FORMAT_FLOAT : SF_FORMAT_PCM_24);
+    const MeasurementSet set = throughFiles(spec, truth);
     std::vector<Outcome> out;
     for (const std::uint64_t split : splitSeeds) {
         DiagnoseOptions opt;
         opt.seed = split;
-        out.push_back({diagnose(readMeasurementSet(dir / "set"), opt), truth});
+        out.push_back({diagnose(set, opt), truth});
     }
-    fs::remove_all(dir);
     return out;
 }
 
@@ -404,18 +412,13 @@ TEST(DiagnoseReferenceLong, FindsARollingStringBesideThermalMemory)
 // the truth (its value 2.6 is the torsion's usual miss). Three minutes on 2 cores: `long`.
 TEST(DiagnoseReferenceLong, AContactAndAStrongRollThatOnlyFitTogetherAreNamedAsAPair)
 {
-    const fs::path dir = fs::temp_directory_path() / ("rosin-diagref-pair-" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
     SynthSpec spec;
     spec.generator = "reference";
     spec.effects = {"hertzian_contact", "torsional_compliance"};
     spec.seed = 2056037;
     spec.grid = 12;
     SynthTruth truth;
-    writeMeasurementSet(dir / "set", synthesize(spec, truth), SF_FORMAT_PCM_24);
-    const MeasurementSet set = readMeasurementSet(dir / "set");
-    fs::remove_all(dir);
+    const MeasurementSet set = throughFiles(spec, truth);
     ASSERT_NEAR(truth.params.at("zt_ratio"), 1.52, 0.01);
     ASSERT_NEAR(truth.params.at("load_exponent"), 0.826, 0.001);
 
@@ -447,9 +450,6 @@ TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temp
 // residual beyond the usual one, and no label the set does not hide.
 TEST(DiagnoseReferenceLong, ARateLawOnAFarStifferStringIsNotNamedAsARosinShift)
 {
-    const fs::path dir = fs::temp_directory_path() / ("rosin-diagref-stiff-" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
     SynthSpec spec;
     spec.generator = "reference";
     spec.seed = 2101009;
@@ -457,9 +457,7 @@ TEST(DiagnoseReferenceLong, ARateLawOnAFarStifferStringIsNotNamedAsARosinShift)
     spec.grid = 12;
     spec.rig = {{"inharmonicity", 1e-3}};
     SynthTruth truth;
-    writeMeasurementSet(dir / "set", synthesize(spec, truth), SF_FORMAT_PCM_24);
-    const Diagnosis d = diagnose(readMeasurementSet(dir / "set"), DiagnoseOptions{});
-    fs::remove_all(dir);
+    const Diagnosis d = diagnose(throughFiles(spec, truth), DiagnoseOptions{});
     std::vector<std::string> found;
     for (const auto& f : d.findings) found.push_back(f.effect);
     for (const auto& e : found) EXPECT_NE(std::find(truth.effects.begin(), truth.effects.end(), e), truth.effects.end()) << e << " not hidden";
