@@ -1,6 +1,5 @@
 #include "rosin/lab/Diagnose.h"
 
-#include <Eigen/Dense>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -15,9 +14,6 @@
 
 #include "DiagnoseEngine.h"
 #include "rosin/lab/Error.h"
-#include "rosin/lab/Resample.h"
-#include "rosin/lab/Schumacher.h"
-#include "rosin/lab/SynthData.h"
 
 namespace rosin::lab {
 
@@ -475,69 +471,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         }
     }
     d.final = current;
-    // Calibration intervals and the findings' second interval, from the local curvature.
-    {
-        std::vector<std::string> names;
-        for (const auto& [name, value] : current.params) names.push_back(name);
-        if (!names.empty()) {
-            say("curvature intervals", 0.0);
-            Eigen::VectorXd x(static_cast<Eigen::Index>(names.size())), steps(x.size());
-            for (std::size_t k = 0; k < names.size(); ++k) {
-                x[static_cast<Eigen::Index>(k)] = current.params.at(names[k]);
-                const auto [lo, hi] = boundsOf(names[k], info);
-                steps[static_cast<Eigen::Index>(k)] = 0.03 * (hi - lo);
-            }
-            auto residuals = [&](const Eigen::VectorXd& y) {
-                EffectModel m = current;
-                for (std::size_t k = 0; k < names.size(); ++k) m.params[names[k]] = y[static_cast<Eigen::Index>(k)];
-                const auto e = engine.errors(m, fitSet);
-                Eigen::VectorXd r(static_cast<Eigen::Index>(e.size()));
-                for (std::size_t i = 0; i < e.size(); ++i) r[static_cast<Eigen::Index>(i)] = e[i].total();
-                return r;
-            };
-            const Eigen::MatrixXd cov = curvatureCovariance(residuals, x, steps);
-            for (std::size_t k = 0; k < names.size(); ++k) {
-                const auto kk = static_cast<Eigen::Index>(k);
-                const double v = x[kk], hw = 1.96 * std::sqrt(std::max(0.0, cov(kk, kk)));
-                // The fits never leave the search range, so neither does the interval; one that
-                // spans all of it (a direction with no curvature) marks a parameter not identified.
-                const auto [bottom, top] = boundsOf(names[k], info);
-                // (a parameter that cancels out of the model gets its whole range, whatever the curvature)
-                const bool canFix = identifiable(names[k]);
-                const double lo = canFix ? std::max(v - hw, bottom) : bottom, hi = canFix ? std::min(v + hw, top) : top;
-                if (isNuisance(names[k])) {
-                    // What the fit needed is the model's value, which stands off the rig's by more
-                    // than the curvature says (calibrationDiscrepancy): widened in quadrature.
-                    const auto sd = o.calibrationDiscrepancy.find(names[k]);
-                    const double wide = std::hypot(hw, sd == o.calibrationDiscrepancy.end() ? 0.0 : 1.96 * sd->second);
-                    const double wideLo = std::max(v - wide, bottom), wideHi = std::min(v + wide, top);
-                    std::string meaning = nuisanceMeaning(names[k]);
-                    if (wideHi - wideLo >= 0.9 * (top - bottom)) meaning += "; the data do not narrow its prior: the value is what the model needed";
-                    d.calibration.push_back({names[k], meaning, v, wideLo, wideHi, {lo, hi}});
-                }
-                for (auto& f : d.findings)
-                    if (f.parameters.count(names[k])) {
-                        // the bootstrap's normal interval and the moved halves stay inside the range too
-                        for (auto* m : {&f.parameters, &f.halves})
-                            if (m->count(names[k]))
-                                for (double& x2 : m->at(names[k])) x2 = std::clamp(x2, bottom, top);
-                        f.curvature[names[k]] = {lo, hi};
-                        if (lo <= bottom && hi >= top) f.unidentified.insert(names[k]);
-                    }
-            }
-            // The systematic part: what the rig may be that neither the fits nor the metric can fix.
-            if (!d.findings.empty()) {
-                say("systematic: rig unknowns", 0.0);
-                d.rigUnknowns = rigUnknownMoves(engine, current, names, x, steps, fitSet);
-                const auto sides = movesBySide(d.rigUnknowns);
-                for (auto& f : d.findings)
-                    for (const auto& [name, v] : f.parameters) {
-                        const auto side = sides.find(name);
-                        f.systematic[name] = side != sides.end() ? std::vector<double>{side->second[0], side->second[1]} : std::vector<double>{0.0, 0.0};
-                    }
-            }
-        }
-    }
+    // Calibration intervals and the findings' second interval, from the local curvature; then what
+    // the rig may be that neither the fits nor the metric can fix.
+    addCurvatureIntervals(d, engine, current, fitSet, info, o, [&](const std::string& what) { say(what, 0.0); });
     for (auto& f : d.findings)
         for (const auto& [name, v] : f.parameters)
             if (const double model = discrepancyHalfWidth(o, name, v[0]); model > 0.0) f.discrepancy[name] = model;
@@ -593,45 +529,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     }
     // 6. Two-ended steady strokes: bow-point velocity and friction reconstructed from the end
     //    forces, measured and as the final model would show them.
-    for (const auto& rec : set.twoEnded) {
-        say("two-ended " + rec.id, 0.0);
-        LoopComparison lc;
-        lc.id = rec.id;
-        const double c = 2.0 * info.length * info.f0, tb = info.beta * info.length / c, tn = (1.0 - info.beta) * info.length / c;
-        const double toN = set.units == "V" ? d.scale : 1.0;
-        auto clean = [&](std::vector<double> x) {
-            std::vector<double> head(x.begin(), x.begin() + static_cast<long>(std::min<std::size_t>(x.size(), static_cast<std::size_t>(2e-3 * set.sampleRate) + 1)));
-            const double dc = median(head); // the bow starts from rest: the first moments are the sensor's zero
-            for (double& v : x) v = (v - dc) * toN;
-            zeroPhaseLowPass(x, kCompareCutoff, set.sampleRate);
-            return x;
-        };
-        const Reconstruction m = reconstruct(clean(rec.bridge), clean(rec.far), set.sampleRate, tb, tn, info.z0);
-        const auto P = static_cast<std::size_t>(set.sampleRate / info.f0);
-        if (m.velocity.size() > 4 * P) {
-            lc.measuredV.assign(m.velocity.end() - static_cast<long>(3 * P), m.velocity.end());
-            lc.measuredF.assign(m.friction.end() - static_cast<long>(3 * P), m.friction.end());
-            lc.measuredArea = loopArea(lc.measuredV, lc.measuredF, 0, lc.measuredV.size());
-        }
-        dsp::BowedString<double> sim;
-        sim.prepare(o.simRate, engine.config(d.final));
-        std::vector<double> b(rec.bridge.size() * static_cast<std::size_t>(o.simRate) / static_cast<std::size_t>(set.sampleRate)), f(b.size());
-        for (std::size_t i = 0; i < b.size(); ++i) {
-            const double t = static_cast<double>(i) / o.simRate;
-            b[i] = sim.processSample(rec.force, rec.bowSpeed * std::min(1.0, t / 0.03), engine.beta(d.final));
-            f[i] = sim.waveguide().farEndForce();
-        }
-        zeroPhaseLowPass(b, kCompareCutoff, o.simRate);
-        zeroPhaseLowPass(f, kCompareCutoff, o.simRate);
-        const Reconstruction s2 = reconstruct(b, f, o.simRate, tb, tn, info.z0);
-        const auto Ps = static_cast<std::size_t>(o.simRate / info.f0);
-        if (s2.velocity.size() > 4 * Ps) {
-            lc.finalV.assign(s2.velocity.end() - static_cast<long>(3 * Ps), s2.velocity.end());
-            lc.finalF.assign(s2.friction.end() - static_cast<long>(3 * Ps), s2.friction.end());
-            lc.finalArea = loopArea(lc.finalV, lc.finalF, 0, lc.finalV.size());
-        }
-        d.loops.push_back(std::move(lc));
-    }
+    d.loops = compareTwoEnded(set, info, engine, d.final, d.scale, o, [&](const std::string& what) { say(what, 0.0); });
     d.simulations = engine.simulations();
     d.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return d;

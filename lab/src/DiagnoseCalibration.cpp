@@ -353,4 +353,68 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     return strokes;
 }
 
+void addCurvatureIntervals(Diagnosis& d, const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& fitSet,
+                           const StringInfo& info, const DiagnoseOptions& o, const std::function<void(const std::string&)>& say)
+{
+    std::vector<std::string> names;
+    for (const auto& [name, value] : current.params) names.push_back(name);
+    if (names.empty()) return;
+    say("curvature intervals");
+    Eigen::VectorXd x(static_cast<Eigen::Index>(names.size())), steps(x.size());
+    for (std::size_t k = 0; k < names.size(); ++k) {
+        x[static_cast<Eigen::Index>(k)] = current.params.at(names[k]);
+        const auto [lo, hi] = boundsOf(names[k], info);
+        steps[static_cast<Eigen::Index>(k)] = 0.03 * (hi - lo);
+    }
+    auto residuals = [&](const Eigen::VectorXd& y) {
+        EffectModel m = current;
+        for (std::size_t k = 0; k < names.size(); ++k) m.params[names[k]] = y[static_cast<Eigen::Index>(k)];
+        const auto e = engine.errors(m, fitSet);
+        Eigen::VectorXd r(static_cast<Eigen::Index>(e.size()));
+        for (std::size_t i = 0; i < e.size(); ++i) r[static_cast<Eigen::Index>(i)] = e[i].total();
+        return r;
+    };
+    const Eigen::MatrixXd cov = curvatureCovariance(residuals, x, steps);
+    for (std::size_t k = 0; k < names.size(); ++k) {
+        const auto kk = static_cast<Eigen::Index>(k);
+        const double v = x[kk], hw = 1.96 * std::sqrt(std::max(0.0, cov(kk, kk)));
+        // The fits never leave the search range, so neither does the interval; one that
+        // spans all of it (a direction with no curvature) marks a parameter not identified.
+        const auto [bottom, top] = boundsOf(names[k], info);
+        // (a parameter that cancels out of the model gets its whole range, whatever the curvature)
+        const bool canFix = identifiable(names[k]);
+        const double lo = canFix ? std::max(v - hw, bottom) : bottom, hi = canFix ? std::min(v + hw, top) : top;
+        if (isNuisance(names[k])) {
+            // What the fit needed is the model's value, which stands off the rig's by more
+            // than the curvature says (calibrationDiscrepancy): widened in quadrature.
+            const auto sd = o.calibrationDiscrepancy.find(names[k]);
+            const double wide = std::hypot(hw, sd == o.calibrationDiscrepancy.end() ? 0.0 : 1.96 * sd->second);
+            const double wideLo = std::max(v - wide, bottom), wideHi = std::min(v + wide, top);
+            std::string meaning = nuisanceMeaning(names[k]);
+            if (wideHi - wideLo >= 0.9 * (top - bottom)) meaning += "; the data do not narrow its prior: the value is what the model needed";
+            d.calibration.push_back({names[k], meaning, v, wideLo, wideHi, {lo, hi}});
+        }
+        for (auto& f : d.findings)
+            if (f.parameters.count(names[k])) {
+                // the bootstrap's normal interval and the moved halves stay inside the range too
+                for (auto* m : {&f.parameters, &f.halves})
+                    if (m->count(names[k]))
+                        for (double& x2 : m->at(names[k])) x2 = std::clamp(x2, bottom, top);
+                f.curvature[names[k]] = {lo, hi};
+                if (lo <= bottom && hi >= top) f.unidentified.insert(names[k]);
+            }
+    }
+    // The systematic part: what the rig may be that neither the fits nor the metric can fix.
+    if (!d.findings.empty()) {
+        say("systematic: rig unknowns");
+        d.rigUnknowns = rigUnknownMoves(engine, current, names, x, steps, fitSet);
+        const auto sides = movesBySide(d.rigUnknowns);
+        for (auto& f : d.findings)
+            for (const auto& [name, v] : f.parameters) {
+                const auto side = sides.find(name);
+                f.systematic[name] = side != sides.end() ? std::vector<double>{side->second[0], side->second[1]} : std::vector<double>{0.0, 0.0};
+            }
+    }
+}
+
 } // namespace rosin::lab::diag

@@ -270,6 +270,16 @@ std::vector<RigUnknownTrial> rigUnknownMoves(const Engine& engine, const EffectM
 /// parameter -> {move down, move up}: the largest move per property and side, properties in quadrature.
 std::map<std::string, std::array<double, 2>> movesBySide(const std::vector<RigUnknownTrial>& trials);
 
+/// The final model's parameters, calibration and findings alike, get intervals from the local
+/// curvature on the fit strokes (nuisances widened by the studies' calibration discrepancy), and
+/// the findings the moves of the rig's unknowns.
+void addCurvatureIntervals(Diagnosis& d, const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& fitSet,
+                           const StringInfo& info, const DiagnoseOptions& o, const std::function<void(const std::string&)>& say);
+/// Each two-ended steady stroke's friction loop, measured and as `final` shows it (`scale` takes
+/// the set's sensor units to newtons).
+std::vector<LoopComparison> compareTwoEnded(const MeasurementSet& set, const StringInfo& info, const Engine& engine, const EffectModel& final,
+                                            double scale, const DiagnoseOptions& o, const std::function<void(const std::string&)>& say);
+
 /// The rig's steady-sliding curve from its steady_sliding.csv: the SW00 shape with four factors
 /// (level, the two speed scales, the high-speed floor) by Levenberg-Marquardt on relative residuals.
 struct SteadyFitResult {
