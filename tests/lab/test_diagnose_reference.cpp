@@ -438,6 +438,39 @@ TEST(DiagnoseReferenceLong, AContactAndAStrongRollThatOnlyFitTogetherAreNamedAsA
     EXPECT_LT(hi, 7.5) << "the interval excludes no roll";
 }
 
+// Seed 2058's set 31 (thermal memory, a rate law, a contact of exponent 0.913 and a weak roll):
+// round 1 names the rate law, and in round 2 the contact's first search, beside it, stalls at
+// exponent 1.03 (no contact; validation fall 0.3 %, not significant). Searched again from there
+// with a wider first step it falls 22 % and is named at 0.914. (The restart was judged on the
+// fresh study of seed 2058, this set's: docs/diagnosis.md.)
+TEST(DiagnoseReferenceLong, ALaterRoundsContactSearchedAgainIsNamedAtItsExponent)
+{
+    SynthSpec spec;
+    spec.generator = "reference";
+    spec.effects = {"rate_dependence", "hertzian_contact", "torsional_compliance"};
+    spec.seed = 2058032;
+    spec.grid = 12;
+    SynthTruth truth;
+    const MeasurementSet set = throughFiles(spec, truth);
+    ASSERT_NEAR(truth.params.at("load_exponent"), 0.913, 0.001);
+    auto contactOf = [](const Diagnosis& d) -> const Finding* {
+        for (const auto& f : d.findings)
+            if (f.effect == "hertzian_contact") return &f;
+        return nullptr;
+    };
+    DiagnoseOptions once;
+    once.restartContact = false;
+    EXPECT_EQ(contactOf(diagnose(set, once)), nullptr);
+    const Diagnosis d = diagnose(set, DiagnoseOptions{});
+    const Finding* contact = contactOf(d);
+    ASSERT_NE(contact, nullptr);
+    const auto [lo, hi] = reportedInterval(*contact, "load_exponent");
+    EXPECT_NEAR(contact->parameters.at("load_exponent")[0], 0.913, 0.03);
+    EXPECT_LE(lo, 0.913);
+    EXPECT_GE(hi, 0.913);
+    EXPECT_LT(hi, 1.0) << "the interval excludes Amontons";
+}
+
 TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temperature_shift"}, {{"r_A", 1.2}, {"shift_k", -14.0}}, 45)); }
 
 // The set that made rule 6 and now meets rule 2's shift margin first: seed 2101's set 8, a rate law (p 0.54) on a string ten times

@@ -77,6 +77,9 @@ struct DiagnoseCommand {
         diagnoseCmd->add_flag("--pairs,!--no-pairs", diagOptions.tryPairs,
                               "When a round names nothing, try a Hertzian contact and a rolling string together as one candidate")
             ->capture_default_str();
+        diagnoseCmd->add_flag("--contact-restart,!--no-contact-restart", diagOptions.restartContact,
+                              "A later round's Hertzian contact is searched again from where its first search ended, with a wider first step")
+            ->capture_default_str();
         diagnoseCmd->add_flag("!--no-nuisances", diagOptions.fitNuisances, "Do not fit tension, bow position and the bow side's thermal effusivity as calibration");
         diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
         return diagnoseCmd;

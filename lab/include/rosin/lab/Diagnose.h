@@ -79,6 +79,11 @@ struct DiagnoseOptions {
     /// named only when it also beats each of its two effects alone by the naming threshold (a
     /// rolling string beside a contact can fit worse alone than no effect: docs/diagnosis.md).
     bool tryPairs = false;
+    /// A later round's contact is searched a second time from where its first search ended, with
+    /// a wider first step (0.35 of each range), and the better fit is kept: beside a named effect
+    /// it carries r_A and the nuisances too, and its first search can stall where they stood
+    /// (docs/diagnosis.md).
+    bool restartContact = true;
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     /// The model's own error on rigs it does not describe (their thermal constants, an unnamed
     /// torsion): the standard deviation that a finding's parameter still misses the truth by
