@@ -212,6 +212,12 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             d.trials.push_back(trial);
             return t;
         };
+        // A further search of c from `from` (no grid); its end replaces x when it fits the fit strokes better.
+        auto searchAgain = [&](const Candidate& c, std::vector<double> from, int evaluations, double step, std::vector<double>& x, double& fitError) {
+            double againError = 0.0;
+            std::vector<double> again = diag::fit(engine, current, c, fitSet, std::move(from), evaluations, step, &againError, false);
+            if (againError < fitError) x = std::move(again), fitError = againError;
+        };
         auto passesRuleOne = [&](const Tried& t) { return t.gain[1] > 0.0 && d.trials[t.trial].relativeGain >= o.namingThreshold; };
         for (std::size_t k = 0; k < cands.size(); ++k) {
             say("round " + std::to_string(round) + ": " + cands[k].effect, static_cast<double>(k) / static_cast<double>(cands.size()));
@@ -222,23 +228,13 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             // misses the valley: search also from where round 1 left the torsion on the baseline,
             // with twice the evaluations (COBYLA spends one per parameter, seven or more here,
             // before its first step).
-            if (const auto from = roundOneStart(d.trials, cands[k]); round > 1 && from) {
-                double warmError = 0.0;
-                std::vector<double> warm = diag::fit(engine, current, cands[k], fitSet, *from, 2 * o.maxEvaluations, 0.2, &warmError, false);
-                if (warmError < fitError) {
-                    x = std::move(warm);
-                    fitError = warmError;
-                }
-            }
+            if (const auto from = roundOneStart(d.trials, cands[k]); round > 1 && from)
+                searchAgain(cands[k], *from, 2 * o.maxEvaluations, 0.2, x, fitError);
             // A later round's contact fits r_A and the nuisances beside its exponent, and COBYLA's
             // first simplex can stay where the earlier finding left them (seed 2057, set 6: fit
             // error 0.124 at exponent 0.78, where the contact-and-roll pair's search reached 0.104
             // at 0.68 with no roll): search again from where it ended, with a wider first step.
-            if (o.restartContact && round > 1 && cands[k].effect == "hertzian_contact") {
-                double againError = 0.0;
-                std::vector<double> again = diag::fit(engine, current, cands[k], fitSet, x, o.maxEvaluations, 0.35, &againError, false);
-                if (againError < fitError) x = std::move(again), fitError = againError;
-            }
+            if (o.restartContact && round > 1 && cands[k].effect == "hertzian_contact") searchAgain(cands[k], x, o.maxEvaluations, 0.35, x, fitError);
             tried.push_back(evaluate(cands[k], std::move(x), fitError, static_cast<std::uint64_t>(round * 100 + static_cast<int>(k))));
         }
         std::sort(tried.begin(), tried.end(), [](const Tried& a, const Tried& b) { return a.gain[0] > b.gain[0]; });
@@ -343,11 +339,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 if (!raw || alone == tried.end() || other == tried.end()) continue;
                 const Candidate c = withNuisances(*raw, current);
                 say("round " + std::to_string(round) + ": " + c.effect, 0.0);
-                double fitError = 0.0, warmError = 0.0;
+                double fitError = 0.0;
                 std::vector<double> x = diag::fit(engine, current, c, fitSet, c.start, 2 * o.maxEvaluations, 0.2, &fitError);
-                std::vector<double> warm = diag::fit(engine, current, c, fitSet, startFromParts(c, alone->c, alone->x, other->c, other->x),
-                                                     2 * o.maxEvaluations, 0.2, &warmError, false);
-                if (warmError < fitError) x = std::move(warm), fitError = warmError;
+                searchAgain(c, startFromParts(c, alone->c, alone->x, other->c, other->x), 2 * o.maxEvaluations, 0.2, x, fitError);
                 pairs.push_back(evaluate(c, std::move(x), fitError, static_cast<std::uint64_t>(round * 100 + 50)));
                 const Tried& t = pairs.back();
                 Trial& trial = d.trials[t.trial];

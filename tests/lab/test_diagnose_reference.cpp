@@ -44,6 +44,13 @@ MeasurementSet throughFiles(const SynthSpec& spec, SynthTruth& truth)
     return set;
 }
 
+/// The finding of this effect, or none.
+const Finding* findingOf(const Diagnosis& d, const std::string& effect)
+{
+    const auto f = std::find_if(d.findings.begin(), d.findings.end(), [&](const Finding& x) { return x.effect == effect; });
+    return f == d.findings.end() ? nullptr : &*f;
+}
+
 /// The set, diagnosed once per split seed (one simulation, several fit/validation/test splits).
 std::vector<Outcome> runSplits(const std::vector<std::string>& effects, const std::map<std::string, double>& params, std::uint64_t seed,
                                const std::vector<std::uint64_t>& splitSeeds, int grid = 8, const std::string& gesture = "guettler",
@@ -140,14 +147,14 @@ TEST(DiagnoseReference, FindsRateDependenceAndSaysH0IsNotIdentified)
         std::sort(found.begin(), found.end());
         std::sort(want.begin(), want.end());
         EXPECT_EQ(found, want);
-        const auto rate = std::find_if(o.d.findings.begin(), o.d.findings.end(), [](const Finding& f) { return f.effect == "rate_dependence"; });
-        ASSERT_NE(rate, o.d.findings.end());
+        const Finding* rate = findingOf(o.d, "rate_dependence");
+        ASSERT_NE(rate, nullptr);
         const auto [lo, hi] = reportedInterval(*rate, "p");
         covered += lo <= 0.45 && hi >= 0.45;
         EXPECT_TRUE(rate->unidentified.count("h0"));
         ps.push_back(rate->parameters.at("p")[0]);
-        const auto thermal = std::find_if(o.d.findings.begin(), o.d.findings.end(), [](const Finding& f) { return f.effect == "thermal_memory"; });
-        ASSERT_NE(thermal, o.d.findings.end());
+        const Finding* thermal = findingOf(o.d, "thermal_memory");
+        ASSERT_NE(thermal, nullptr);
         EXPECT_NEAR(thermal->parameters.at("r_A")[0], 1.0, 0.1);
         // A rosin shift can stand in for a rate law: a shift was fitted in the round that named the
         // rate dependence, and the rate dependence beat it by the naming threshold.
@@ -300,8 +307,8 @@ TEST(DiagnoseReferenceLong, MixedSetsFindThermalMemoryAndMostOfTheirFootprints)
     int within = 0;
     for (const std::uint64_t seed : {47u, 9121u, 9122u, 9123u, 9124u, 9125u}) {
         const Outcome o = run({"thermal_memory"}, {{"r_A", 0.8}}, seed, 8, "mixed");
-        const auto thermal = std::find_if(o.d.findings.begin(), o.d.findings.end(), [](const Finding& f) { return f.effect == "thermal_memory"; });
-        ASSERT_NE(thermal, o.d.findings.end()) << "seed " << seed;
+        const Finding* thermal = findingOf(o.d, "thermal_memory");
+        ASSERT_NE(thermal, nullptr) << "seed " << seed;
         within += std::abs(thermal->parameters.at("r_A")[0] / 0.8 - 1.0) <= kTolerance.at("r_A").value;
     }
     EXPECT_GE(within, 4);
@@ -453,16 +460,11 @@ TEST(DiagnoseReferenceLong, ALaterRoundsContactSearchedAgainIsNamedAtItsExponent
     SynthTruth truth;
     const MeasurementSet set = throughFiles(spec, truth);
     ASSERT_NEAR(truth.params.at("load_exponent"), 0.913, 0.001);
-    auto contactOf = [](const Diagnosis& d) -> const Finding* {
-        for (const auto& f : d.findings)
-            if (f.effect == "hertzian_contact") return &f;
-        return nullptr;
-    };
     DiagnoseOptions once;
     once.restartContact = false;
-    EXPECT_EQ(contactOf(diagnose(set, once)), nullptr);
+    EXPECT_EQ(findingOf(diagnose(set, once), "hertzian_contact"), nullptr);
     const Diagnosis d = diagnose(set, DiagnoseOptions{});
-    const Finding* contact = contactOf(d);
+    const Finding* contact = findingOf(d, "hertzian_contact");
     ASSERT_NE(contact, nullptr);
     const auto [lo, hi] = reportedInterval(*contact, "load_exponent");
     EXPECT_NEAR(contact->parameters.at("load_exponent")[0], 0.913, 0.03);
