@@ -212,29 +212,36 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             d.trials.push_back(trial);
             return t;
         };
-        // A further search of c from `from` (no grid); its end replaces x when it fits the fit strokes better.
-        auto searchAgain = [&](const Candidate& c, std::vector<double> from, int evaluations, double step, std::vector<double>& x, double& fitError) {
+        // A further search of c on `base` from `from` (no grid); its end replaces x when it fits the fit strokes better.
+        auto searchAgain = [&](const EffectModel& base, const Candidate& c, std::vector<double> from, int evaluations, double step,
+                               std::vector<double>& x, double& fitError) {
             double againError = 0.0;
-            std::vector<double> again = diag::fit(engine, current, c, fitSet, std::move(from), evaluations, step, &againError, false);
+            std::vector<double> again = diag::fit(engine, base, c, fitSet, std::move(from), evaluations, step, &againError, false);
             if (againError < fitError) x = std::move(again), fitError = againError;
         };
-        auto passesRuleOne = [&](const Tried& t) { return t.gain[1] > 0.0 && d.trials[t.trial].relativeGain >= o.namingThreshold; };
-        for (std::size_t k = 0; k < cands.size(); ++k) {
-            say("round " + std::to_string(round) + ": " + cands[k].effect, static_cast<double>(k) / static_cast<double>(cands.size()));
-            double fitError = 0;
-            std::vector<double> x = diag::fit(engine, current, cands[k], fitSet, cands[k].start, o.maxEvaluations, 0.2, &fitError);
+        // A candidate's whole search on `base`: the grid and COBYLA, then the further searches below.
+        // The same routine refits this round's winner without an earlier finding, so the two models
+        // compared there were searched equally hard.
+        auto search = [&](const EffectModel& base, const Candidate& c, double& fitError) {
+            std::vector<double> x = diag::fit(engine, base, c, fitSet, c.start, o.maxEvaluations, 0.2, &fitError);
             // A rolling string changes the scale of every force the ramps read, so the parameters
             // named without it sit far from where they belong beside it, and the grid from there
             // misses the valley: search also from where round 1 left the torsion on the baseline,
             // with twice the evaluations (COBYLA spends one per parameter, seven or more here,
             // before its first step).
-            if (const auto from = roundOneStart(d.trials, cands[k]); round > 1 && from)
-                searchAgain(cands[k], *from, 2 * o.maxEvaluations, 0.2, x, fitError);
+            if (const auto from = roundOneStart(d.trials, c); round > 1 && from) searchAgain(base, c, *from, 2 * o.maxEvaluations, 0.2, x, fitError);
             // A later round's contact fits r_A and the nuisances beside its exponent, and COBYLA's
             // first simplex can stay where the earlier finding left them (seed 2057, set 6: fit
             // error 0.124 at exponent 0.78, where the contact-and-roll pair's search reached 0.104
             // at 0.68 with no roll): search again from where it ended, with a wider first step.
-            if (o.restartContact && round > 1 && cands[k].effect == "hertzian_contact") searchAgain(cands[k], x, o.maxEvaluations, 0.35, x, fitError);
+            if (o.restartContact && round > 1 && c.effect == "hertzian_contact") searchAgain(base, c, x, o.maxEvaluations, 0.35, x, fitError);
+            return x;
+        };
+        auto passesRuleOne = [&](const Tried& t) { return t.gain[1] > 0.0 && d.trials[t.trial].relativeGain >= o.namingThreshold; };
+        for (std::size_t k = 0; k < cands.size(); ++k) {
+            say("round " + std::to_string(round) + ": " + cands[k].effect, static_cast<double>(k) / static_cast<double>(cands.size()));
+            double fitError = 0;
+            std::vector<double> x = search(current, cands[k], fitError);
             tried.push_back(evaluate(cands[k], std::move(x), fitError, static_cast<std::uint64_t>(round * 100 + static_cast<int>(k))));
         }
         std::sort(tried.begin(), tried.end(), [](const Tried& a, const Tried& b) { return a.gain[0] > b.gain[0]; });
@@ -341,7 +348,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 say("round " + std::to_string(round) + ": " + c.effect, 0.0);
                 double fitError = 0.0;
                 std::vector<double> x = diag::fit(engine, current, c, fitSet, c.start, 2 * o.maxEvaluations, 0.2, &fitError);
-                searchAgain(c, startFromParts(c, alone->c, alone->x, other->c, other->x), 2 * o.maxEvaluations, 0.2, x, fitError);
+                searchAgain(current, c, startFromParts(c, alone->c, alone->x, other->c, other->x), 2 * o.maxEvaluations, 0.2, x, fitError);
                 pairs.push_back(evaluate(c, std::move(x), fitError, static_cast<std::uint64_t>(round * 100 + 50)));
                 const Tried& t = pairs.back();
                 Trial& trial = d.trials[t.trial];
@@ -402,14 +409,17 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 if (effect == "thermal_memory" && std::any_of(current.effects.begin(), current.effects.end(), needsThermal)) continue;
                 say("round " + std::to_string(round) + ": without " + effect, 0.0);
                 // Searched as hard as the model it is compared with: this round's winner is fitted
-                // again, grid and all, on the model that never named the earlier effect (a joint
-                // refit from where the earlier effect left the other parameters stays there). The
-                // winner is new this round, so the model without the earlier effect offers it.
+                // again on the model that never named the earlier effect, by the search that found
+                // it (a joint refit from where the earlier effect left the other parameters stays
+                // there). The winner is new this round, so the model without the earlier effect
+                // offers it. A pair's further start from its two parts is not repeated: its parts
+                // were fitted beside the earlier effect.
                 const EffectModel before = removed(earlier, effect);
                 const auto winner = offered(before, best->c.effect);
                 if (!winner) continue;
                 const Candidate c = withNuisances(*winner, before);
-                Without w{effect, apply(before, c, diag::fit(engine, before, c, fitSet, c.start, o.maxEvaluations, 0.2)), {}, 0.0};
+                double fitError = 0.0;
+                Without w{effect, apply(before, c, search(before, c, fitError)), {}, 0.0};
                 w.val = engine.errors(w.model, valSet);
                 w.share = relativeFall(mean(w.val), mean(currentVal));
                 tested.push_back(std::move(w));
