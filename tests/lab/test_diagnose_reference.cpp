@@ -44,6 +44,20 @@ MeasurementSet throughFiles(const SynthSpec& spec, SynthTruth& truth)
     return set;
 }
 
+/// A set as `rosin study` makes it (12x12 Guettler strokes from the reference simulator, the set's
+/// own seed: the study's seed times 1000 plus its index plus one), through files.
+MeasurementSet studySet(const std::vector<std::string>& effects, std::uint64_t seed, SynthTruth& truth,
+                        const std::map<std::string, double>& rig = {})
+{
+    SynthSpec spec;
+    spec.generator = "reference";
+    spec.effects = effects;
+    spec.seed = seed;
+    spec.grid = 12;
+    spec.rig = rig;
+    return throughFiles(spec, truth);
+}
+
 /// The finding of this effect, or none.
 const Finding* findingOf(const Diagnosis& d, const std::string& effect)
 {
@@ -419,13 +433,8 @@ TEST(DiagnoseReferenceLong, FindsARollingStringBesideThermalMemory)
 // the truth (its value 2.6 is the torsion's usual miss). Three minutes on 2 cores: `long`.
 TEST(DiagnoseReferenceLong, AContactAndAStrongRollThatOnlyFitTogetherAreNamedAsAPair)
 {
-    SynthSpec spec;
-    spec.generator = "reference";
-    spec.effects = {"hertzian_contact", "torsional_compliance"};
-    spec.seed = 2056037;
-    spec.grid = 12;
     SynthTruth truth;
-    const MeasurementSet set = throughFiles(spec, truth);
+    const MeasurementSet set = studySet({"hertzian_contact", "torsional_compliance"}, 2056037, truth);
     ASSERT_NEAR(truth.params.at("zt_ratio"), 1.52, 0.01);
     ASSERT_NEAR(truth.params.at("load_exponent"), 0.826, 0.001);
 
@@ -452,13 +461,8 @@ TEST(DiagnoseReferenceLong, AContactAndAStrongRollThatOnlyFitTogetherAreNamedAsA
 // fresh study of seed 2058, this set's: docs/diagnosis.md.)
 TEST(DiagnoseReferenceLong, ALaterRoundsContactSearchedAgainIsNamedAtItsExponent)
 {
-    SynthSpec spec;
-    spec.generator = "reference";
-    spec.effects = {"rate_dependence", "hertzian_contact", "torsional_compliance"};
-    spec.seed = 2058032;
-    spec.grid = 12;
     SynthTruth truth;
-    const MeasurementSet set = throughFiles(spec, truth);
+    const MeasurementSet set = studySet({"rate_dependence", "hertzian_contact", "torsional_compliance"}, 2058032, truth);
     ASSERT_NEAR(truth.params.at("load_exponent"), 0.913, 0.001);
     DiagnoseOptions once;
     once.restartContact = false;
@@ -483,13 +487,8 @@ TEST(DiagnoseReferenceLong, ALaterRoundsContactSearchedAgainIsNamedAtItsExponent
 // 0.506, 0.410 and 0.359, and every finding still clears the 5 % threshold by far.
 TEST(DiagnoseReferenceLong, AnEarlierFindingIsTestedAgainstAModelSearchedAsHard)
 {
-    SynthSpec spec;
-    spec.generator = "reference";
-    spec.effects = {"rate_dependence", "hertzian_contact", "torsional_compliance"};
-    spec.seed = 2058028;
-    spec.grid = 12;
     SynthTruth truth;
-    const MeasurementSet set = throughFiles(spec, truth);
+    const MeasurementSet set = studySet({"rate_dependence", "hertzian_contact", "torsional_compliance"}, 2058028, truth);
     ASSERT_NEAR(truth.params.at("zt_ratio"), 2.57, 0.01);
     const Diagnosis d = diagnose(set, DiagnoseOptions{});
     for (const char* effect : {"thermal_memory", "rate_dependence", "hertzian_contact", "torsional_compliance"})
@@ -517,14 +516,8 @@ TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temp
 // residual beyond the usual one, and no label the set does not hide.
 TEST(DiagnoseReferenceLong, ARateLawOnAFarStifferStringIsNotNamedAsARosinShift)
 {
-    SynthSpec spec;
-    spec.generator = "reference";
-    spec.seed = 2101009;
-    spec.effects = {"rate_dependence"};
-    spec.grid = 12;
-    spec.rig = {{"inharmonicity", 1e-3}};
     SynthTruth truth;
-    const Diagnosis d = diagnose(throughFiles(spec, truth), DiagnoseOptions{});
+    const Diagnosis d = diagnose(studySet({"rate_dependence"}, 2101009, truth, {{"inharmonicity", 1e-3}}), DiagnoseOptions{});
     std::vector<std::string> found;
     for (const auto& f : d.findings) found.push_back(f.effect);
     for (const auto& e : found) EXPECT_NE(std::find(truth.effects.begin(), truth.effects.end(), e), truth.effects.end()) << e << " not hidden";
