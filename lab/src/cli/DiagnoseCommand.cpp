@@ -75,10 +75,10 @@ struct DiagnoseCommand {
                                 "calibrated nuisance (tension_scale, beta_scale, rod_effusivity_scale: scales), "
                                 "instead of the study-calibrated default (" + defaultDiscrepancyText() + ")");
         diagnoseCmd->add_flag("--pairs,!--no-pairs", diagOptions.tryPairs,
-                              "When a round names nothing, try a Hertzian contact and a rolling string together as one candidate")
+                              "When a round names nothing, try a Hertzian contact and a rolling string together as one candidate (default: off)")
             ->capture_default_str();
         diagnoseCmd->add_flag("--contact-restart,!--no-contact-restart", diagOptions.restartContact,
-                              "A later round's Hertzian contact is searched again from where its first search ended, with a wider first step")
+                              "A later round's Hertzian contact is searched again from where its first search ended, with a wider first step (default: on)")
             ->capture_default_str();
         diagnoseCmd->add_flag("!--no-nuisances", diagOptions.fitNuisances, "Do not fit tension, bow position and the bow side's thermal effusivity as calibration");
         diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
