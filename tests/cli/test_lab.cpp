@@ -298,6 +298,16 @@ TEST(RosinCli, HelpExplainsTheCommandsAndGestures)
     EXPECT_EQ(render.status, 0);
     for (const char* word : {"guettler", "exp-force", "--gesture-file", "newtons", "--contact", "--rosin"})
         EXPECT_NE(render.output.find(word), std::string::npos) << word;
+    // CLI11 shows a two-way flag's spellings, not its default, so the text must say it
+    const CliRun diagnose = runRosin("diagnose --help");
+    EXPECT_EQ(diagnose.status, 0);
+    const auto helpOf = [&](const std::string& flag) {
+        const std::size_t at = diagnose.output.find("  " + flag + ",");
+        if (at == std::string::npos) return std::string();
+        return diagnose.output.substr(at, diagnose.output.find("\n  -", at + 1) - at); // up to the next option
+    };
+    EXPECT_NE(helpOf("--pairs").find("(default: off)"), std::string::npos) << helpOf("--pairs");
+    EXPECT_NE(helpOf("--contact-restart").find("(default: on)"), std::string::npos) << helpOf("--contact-restart");
 }
 
 TEST(RosinCli, StringsListsEveryPreset)
