@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rosin/dsp.h"
+#include "rosin/lab/Diagnose.h"
 #include "rosin/lab/Error.h"
 #include "rosin/presets/Presets.h"
 
@@ -31,6 +32,20 @@ inline CLI::Validator finiteIn(double lo, double hi)
             return {};
         },
         "FLOAT in [" + CLI::detail::to_string(lo) + " - " + CLI::detail::to_string(hi) + "]");
+}
+
+/// The diagnosis's two search switches, which `diagnose` and `study` both take. CLI11 shows a
+/// two-way flag's spellings, not its default, so the text says the default, read from the options.
+inline void addSearchFlags(CLI::App& cmd, DiagnoseOptions& o)
+{
+    const auto byDefault = [](bool on) { return std::string(on ? " (default: on)" : " (default: off)"); };
+    cmd.add_flag("--pairs,!--no-pairs", o.tryPairs,
+                 "When a round names nothing, try a Hertzian contact and a rolling string together as one candidate" + byDefault(o.tryPairs))
+        ->capture_default_str();
+    cmd.add_flag("--contact-restart,!--no-contact-restart", o.restartContact,
+                 "A later round's Hertzian contact is searched again from where its first search ended, with a wider first step" +
+                     byDefault(o.restartContact))
+        ->capture_default_str();
 }
 
 /// Choices shared by every command that builds a model.

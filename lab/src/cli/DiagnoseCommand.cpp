@@ -74,12 +74,7 @@ struct DiagnoseCommand {
                                 "NAME=SD: the model's own error for parameter NAME (r_A and zt_ratio relative, others absolute; 0 = none) or for a "
                                 "calibrated nuisance (tension_scale, beta_scale, rod_effusivity_scale: scales), "
                                 "instead of the study-calibrated default (" + defaultDiscrepancyText() + ")");
-        diagnoseCmd->add_flag("--pairs,!--no-pairs", diagOptions.tryPairs,
-                              "When a round names nothing, try a Hertzian contact and a rolling string together as one candidate (default: off)")
-            ->capture_default_str();
-        diagnoseCmd->add_flag("--contact-restart,!--no-contact-restart", diagOptions.restartContact,
-                              "A later round's Hertzian contact is searched again from where its first search ended, with a wider first step (default: on)")
-            ->capture_default_str();
+        addSearchFlags(*diagnoseCmd, diagOptions);
         diagnoseCmd->add_flag("!--no-nuisances", diagOptions.fitNuisances, "Do not fit tension, bow position and the bow side's thermal effusivity as calibration");
         diagnoseCmd->add_flag("-q,--quiet", diagOptions.quiet, "No progress and no summary");
         return diagnoseCmd;

@@ -49,12 +49,7 @@ struct StudyCommand {
         cmd->add_option("--rig-param", rigValues,
                         "Reference rig value NAME=VALUE fixed in every set instead of drawn (names: rosin synth-data --help), e.g. "
                         "inharmonicity=1e-3 for strongly stiff strings");
-        cmd->add_flag("--pairs,!--no-pairs", options.diagnose.tryPairs,
-                      "Diagnoses try a Hertzian contact and a rolling string together when a round names nothing (default: off)")
-            ->capture_default_str();
-        cmd->add_flag("--contact-restart,!--no-contact-restart", options.diagnose.restartContact,
-                      "Diagnoses search a later round's Hertzian contact again from where its first search ended, with a wider first step (default: on)")
-            ->capture_default_str();
+        addSearchFlags(*cmd, options.diagnose);
         cmd->add_flag("--keep-sets", options.keepSets, "Keep the generated WAV sets");
         cmd->add_option("--only", options.only, "Run only these sets (indices, e.g. 3,13; the folder's plan stays the whole study)")->delimiter(',')->check(CLI::NonNegativeNumber);
         cmd->add_option("--hiding", options.hiding, "Run only the sets that hide this effect")->check(CLI::IsMember(effectIds()));
