@@ -298,6 +298,8 @@ public:
     /// The voice of model m: its effects, the set's steady-sliding curve and the nuisances.
     dsp::BowedStringConfig config(const EffectModel& m) const;
     double beta(const EffectModel& m) const;
+    /// The recordings' scale was read from their pre-slip ramps (a set in volts).
+    bool scaleFromRamps() const { return scaleFromRamps_; }
     /// Simulated features of stroke i under model m as the rig would record them: the
     /// recording's own noise level is added (from a fixed seed per stroke, so a fit sees a
     /// smooth objective) and the first slip is found as in a recording. Force and acceleration
@@ -318,8 +320,8 @@ private:
         double gain = 1.0; ///< recordedGain() of the model, taken when the voice is prepared
     };
     /// What a model (voice config c) has its simulated bridge force multiplied by before it meets
-    /// the recordings: 1, or 1 / rollingSoftening() when the scale came from the ramps.
-    double recordedGain(const dsp::BowedStringConfig& c) const;
+    /// the recordings: 1, or 1 / (rollingSoftening() x ramp_softening) when the scale came from the ramps.
+    double recordedGain(const EffectModel& m, const dsp::BowedStringConfig& c) const;
     std::vector<Prepared>& strokes_;
     StringInfo info_;
     double fs_;
