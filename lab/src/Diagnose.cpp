@@ -544,13 +544,11 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         d.measuredForce[i].assign(strokes[i].force.begin(), strokes[i].force.begin() + static_cast<long>(std::min(strokes[i].force.size(), d.baselineForce[i].size())));
     });
     // 5. The ramps' scale assumed a string that does not roll. Every fit compared a rolling model
-    //    in that scale (Engine::recordedGain); a named torsion now says how much softer the ramps
+    //    in that scale (Engine::rampSoftening); a named torsion now says how much softer the ramps
     //    were, so the reported scale takes that factor (the final model's, at its own Z_t/Z_0).
     //    A free ramp_softening (--free-ramp-scale) is that factor for a roll the model lacks.
     //    Its interval carries ramp_softening's own.
-    const double softer = set.units == "V" ? rollingSoftening(engine.config(d.final)) *
-                                                 (d.final.params.count("ramp_softening") ? d.final.params.at("ramp_softening") : 1.0)
-                                           : 1.0;
+    const double softer = engine.rampSoftening(d.final);
     std::array<double, 2> softerRange{softer, softer};
     for (const auto& c : d.calibration)
         if (c.name == "ramp_softening" && c.value > 0.0) softerRange = {softer * c.low / c.value, softer * c.high / c.value};

@@ -86,7 +86,7 @@ std::vector<RigUnknown> rigUnknowns(const EffectModel& m)
             out.push_back({"contact_radius", "contact radius " + std::to_string(std::lround(um)) + " um", {}, {{"contact_radius_scale", um * 1e-6 / a}}});
     // Torsion: beside thermal memory mostly below the metric's floor (docs/diagnosis-study.md),
     // yet a rolling string softens the pre-slip ramp (and inflates a ramp-read scale, which the
-    // move carries as every fit does: Engine::recordedGain), which p and the load exponent take
+    // move carries as every fit does: Engine::rampSoftening), which p and the load exponent take
     // up. Z_t/Z_0 = 2 is a string that rolls readily (the reference rigs draw 1.2-8).
     if (!has(m.effects, "torsional_compliance"))
         out.push_back({"torsion", "torsion at Z_t/Z_0 = 2", {"torsional_compliance"}, {{"zt_ratio", 2.0}}});
@@ -283,7 +283,7 @@ EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector
         if (!has(m.effects, e)) m.effects.push_back(e);
     for (std::size_t k = 0; k < c.names.size(); ++k) m.params[c.names[k]] = x[k];
     // ramp_softening is the softening of a roll the model lacks: a model with torsion makes its own
-    // (Engine::recordedGain), so the two cannot trade and the reported scale takes it once.
+    // (Engine::rampSoftening), so the two cannot trade and the reported scale takes it once.
     if (has(m.effects, "torsional_compliance") && m.params.count("ramp_softening")) m.params["ramp_softening"] = 1.0;
     return m;
 }

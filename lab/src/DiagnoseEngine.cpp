@@ -180,7 +180,7 @@ double relativeRampSlope(double tensionScale, double betaScale)
     return tensionScale / betaScale;
 }
 
-double Engine::recordedGain(const EffectModel& m, const dsp::BowedStringConfig& c) const
+double Engine::rampSoftening(const EffectModel& m, const dsp::BowedStringConfig& c) const
 {
     // ramp_softening (when the diagnosis leaves the scale free) is the softening of a roll the
     // model lacks; a model with torsion holds it at 1 (apply()).
@@ -191,7 +191,7 @@ double Engine::recordedGain(const EffectModel& m, const dsp::BowedStringConfig& 
     // thermal memory unnamed (docs/diagnosis.md, step 2).
     if (!scaleFromRamps_) return 1.0;
     const auto k = m.params.find("ramp_softening");
-    return 1.0 / (rollingSoftening(c) * (k == m.params.end() ? 1.0 : k->second));
+    return rollingSoftening(c) * (k == m.params.end() ? 1.0 : k->second);
 }
 
 Engine::Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady,
@@ -214,7 +214,7 @@ StrokeFeatures Engine::simulate(const EffectModel& m, std::size_t i, std::vector
         const dsp::BowedStringConfig c = config(m);
         v.string->prepare(fs_, c);
         v.model = m;
-        v.gain = recordedGain(m, c);
+        v.gain = 1.0 / rampSoftening(m, c);
     } else {
         v.string->reset();
     }

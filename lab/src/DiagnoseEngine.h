@@ -300,6 +300,11 @@ public:
     double beta(const EffectModel& m) const;
     /// The recordings' scale was read from their pre-slip ramps (a set in volts).
     bool scaleFromRamps() const { return scaleFromRamps_; }
+    /// How much softer than a non-rolling string's model m's ramps are: its own roll's
+    /// rollingSoftening() times ramp_softening (a roll it lacks); 1 when the scale did not come
+    /// from the ramps. A voice's recorded gain is its inverse.
+    double rampSoftening(const EffectModel& m, const dsp::BowedStringConfig& c) const;
+    double rampSoftening(const EffectModel& m) const { return rampSoftening(m, config(m)); }
     /// Simulated features of stroke i under model m as the rig would record them: the
     /// recording's own noise level is added (from a fixed seed per stroke, so a fit sees a
     /// smooth objective) and the first slip is found as in a recording. Force and acceleration
@@ -317,11 +322,8 @@ private:
     struct Voice {
         EffectModel model;
         std::unique_ptr<dsp::BowedString<double>> string;
-        double gain = 1.0; ///< recordedGain() of the model, taken when the voice is prepared
+        double gain = 1.0; ///< 1 / rampSoftening() of the model, taken when the voice is prepared
     };
-    /// What a model (voice config c) has its simulated bridge force multiplied by before it meets
-    /// the recordings: 1, or 1 / (rollingSoftening() x ramp_softening) when the scale came from the ramps.
-    double recordedGain(const EffectModel& m, const dsp::BowedStringConfig& c) const;
     std::vector<Prepared>& strokes_;
     StringInfo info_;
     double fs_;

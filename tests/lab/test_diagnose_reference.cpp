@@ -369,7 +369,7 @@ const std::map<std::string, double> kQuietRig{{"inharmonicity", 1e-8}, {"bridge_
 // A string that rolls readily (Z_t/Z_0 = 1.5), on a rig whose string, bridge and sensor come close
 // to the waveguide's (little stiffness, a stiff bridge, a fast sensor), in volts: the ramps' scale
 // reads the rolling string as a stiffer one and inflates every force by about 15 % (this rig's
-// c_t is 4.5 c), which a model with torsion is compared in (Engine::recordedGain). Named, and the
+// c_t is 4.5 c), which a model with torsion is compared in (Engine::rampSoftening). Named, and the
 // reported scale within 3 % of the rig's gain once the named torsion's softening is taken out. Compared unscaled, nothing was named and the scale 12 % high.
 // The scale and the label, on one split: Z_t/Z_0 itself is the long test below (since the
 // simulations carry the rig's own noise, 2026-11-29, this split puts it at 1.82, 22 % high).
