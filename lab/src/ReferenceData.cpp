@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <numbers>
 #include <random>
@@ -122,6 +123,39 @@ std::map<std::string, double> parseRigValues(const std::vector<std::string>& nam
     return rig;
 }
 
+namespace {
+void checkParamRange(const std::string& key, double lo, double hi)
+{
+    const auto& priors = referenceEffectPriors();
+    const auto prior = priors.find(key);
+    if (prior == priors.end()) throw LabError("--param-range: unknown parameter '" + key + "' (r_A, h0, p, load_exponent, shift_k, zt_ratio)");
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi))
+        throw LabError("--param-range: " + key + " needs LO < HI, both finite");
+    const auto [plo, phi] = prior->second;
+    if (lo < plo || hi > phi)
+    {
+        char prior[64];
+        std::snprintf(prior, sizeof prior, "%g to %g", plo, phi);
+        throw LabError("--param-range: " + key + " must lie within its prior, " + prior);
+    }
+}
+} // namespace
+
+std::map<std::string, std::pair<double, double>> parseParamRanges(const std::vector<std::string>& nameEqualsRange)
+{
+    std::map<std::string, std::pair<double, double>> ranges;
+    for (const auto& kv : nameEqualsRange) {
+        const auto eq = kv.find('=');
+        const auto colon = kv.find(':', eq == std::string::npos ? 0 : eq);
+        if (eq == std::string::npos || colon == std::string::npos) throw LabError("--param-range: expected NAME=LO:HI, got '" + kv + "'");
+        const std::optional<double> lo = wholeNumber(kv.substr(eq + 1, colon - eq - 1)), hi = wholeNumber(kv.substr(colon + 1));
+        if (!lo || !hi) throw LabError("--param-range: '" + kv + "' needs two numbers, LO:HI");
+        checkParamRange(kv.substr(0, eq), *lo, *hi);
+        ranges[kv.substr(0, eq)] = {*lo, *hi};
+    }
+    return ranges;
+}
+
 MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress)
 {
     if (spec.grid < 2 || spec.grid > 60) throw LabError("--grid must be within 2..60");
@@ -129,6 +163,7 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     if (spec.oversampling < 4 || spec.oversampling > 32) throw LabError("--oversampling must be within 4..32 (the reference runs at least 4x the file rate)");
     if (spec.units != "V" && spec.units != "N") throw LabError("--units must be V or N");
     for (const auto& [key, value] : spec.rig) checkRigValue(key, value);
+    for (const auto& [key, range] : spec.paramRanges) checkParamRange(key, range.first, range.second);
     std::mt19937_64 rng(spec.seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     truth = SynthTruth{};
@@ -138,7 +173,8 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         if (has(spec.effects, id) || implied) truth.effects.push_back(id);
     }
     auto draw = [&](const char* key) {
-        const auto [lo, hi] = referenceEffectPriors().at(key);
+        const auto narrowed = spec.paramRanges.find(key);
+        const auto [lo, hi] = narrowed != spec.paramRanges.end() ? narrowed->second : referenceEffectPriors().at(key);
         const double x = lo + (hi - lo) * u(rng);
         const auto it = spec.params.find(key);
         truth.params[key] = it != spec.params.end() ? it->second : x;

@@ -150,13 +150,14 @@ json readPlan(const fs::path& dir)
     return plan;
 }
 
-/// What must match for studies to be scored as one: the strokes and the rig population. The seed,
+/// What must match for studies to be scored as one: the strokes, the rig population and the
+/// effects' size ranges (a study of narrowed sizes would skew a pooled detection rate). The seed,
 /// the number of sets and the plan version may differ (a plan of either version draws its sets
 /// from the same population of rigs and effects).
 json populationOf(const json& plan)
 {
     json p;
-    for (const char* key : {"grid", "gesture", "units", "rig"})
+    for (const char* key : {"grid", "gesture", "units", "rig", "param_ranges"})
         if (plan.contains(key)) p[key] = plan[key];
     return p;
 }
@@ -245,7 +246,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         const json here = readPlan(study);
         if (populationOf(here) != populationOf(plan))
             throw LabError(study.string() + "/plan.json: " + populationOf(here).dump() + " where " + studies.front().string() + " has " +
-                           populationOf(plan).dump() + ": studies scored together must share the grid, gesture, units and fixed rig values");
+                           populationOf(plan).dump() + ": studies scored together must share the grid, gesture, units, fixed rig values and parameter ranges");
         const std::size_t before = sets.size();
         std::vector<fs::path> folders;
         for (const auto& e : fs::directory_iterator(study / "sets")) folders.push_back(e.path());
@@ -332,6 +333,14 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         for (const auto& [k, v] : plan["rig"].items()) fixed += (fixed.empty() ? "" : ", ") + k + fmt(" = %.3g", v.get<double>());
         md << "Rig values fixed in every set instead of drawn: " << fixed << ".\n";
         summary["fixed_rig"] = plan["rig"];
+    }
+    if (plan.contains("param_ranges")) {
+        std::string narrowed;
+        for (const auto& [k, v] : plan["param_ranges"].items())
+            narrowed += (narrowed.empty() ? "" : ", ") + k + fmt(" %.3g", v[0].get<double>()) + fmt(" to %.3g", v[1].get<double>());
+        md << "Hidden parameters drawn from narrowed ranges, not their whole priors: " << narrowed
+           << ". Detection rates here describe those sizes only, not the study population.\n";
+        summary["param_ranges"] = plan["param_ranges"];
     }
     md << "\n";
     summary["unexplained_residual"] = {

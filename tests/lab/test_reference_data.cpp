@@ -154,6 +154,55 @@ TEST(ReferenceSynthData, RigValuesFromTheCommandLineAreParsedOrRefusedByName)
     EXPECT_NE(refusal({"bridge_z0y="}).find("has no number"), std::string::npos);
 }
 
+// --param-range of study: NAME=LO:HI narrows a hidden parameter's draw; a range outside the
+// prior (where the generator was never meant to go), an empty one or a malformed one is refused.
+TEST(ReferenceSynthData, ParameterRangesAreParsedOrRefusedByName)
+{
+    const auto ranges = parseParamRanges({"zt_ratio=1.2:3", "shift_k=10:20"});
+    ASSERT_EQ(ranges.size(), 2u);
+    EXPECT_EQ(ranges.at("zt_ratio"), std::make_pair(1.2, 3.0));
+    EXPECT_EQ(ranges.at("shift_k"), std::make_pair(10.0, 20.0));
+    const auto refusal = [](const std::vector<std::string>& args) {
+        try {
+            parseParamRanges(args);
+        } catch (const LabError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_NE(refusal({"zt=1.2:3"}).find("unknown parameter 'zt'"), std::string::npos);
+    EXPECT_NE(refusal({"zt_ratio=1.2"}).find("expected NAME=LO:HI"), std::string::npos);
+    EXPECT_NE(refusal({"zt_ratio"}).find("expected NAME=LO:HI"), std::string::npos);
+    EXPECT_NE(refusal({"zt_ratio=a:3"}).find("needs two numbers"), std::string::npos);
+    EXPECT_NE(refusal({"zt_ratio=3:1.5"}).find("LO < HI"), std::string::npos);
+    EXPECT_NE(refusal({"zt_ratio=nan:3"}).find("LO < HI"), std::string::npos);
+    EXPECT_NE(refusal({"zt_ratio=0.5:3"}).find("within its prior, 1.2 to 8"), std::string::npos);
+    EXPECT_NE(refusal({"load_exponent=0.6:1.2"}).find("within its prior"), std::string::npos);
+}
+
+// A narrowed draw lands in its range and moves nothing else: the rig and the other hidden
+// parameters of a set are those the same seed draws without it (the draw takes one number
+// from the stream either way).
+TEST(ReferenceSynthData, ANarrowedRangeMovesOnlyItsOwnParameter)
+{
+    SynthSpec spec = small(31);
+    spec.effects = {"thermal_memory", "torsional_compliance"};
+    SynthTruth whole, narrowed;
+    synthesize(spec, whole);
+    spec.paramRanges = {{"zt_ratio", {1.2, 1.5}}};
+    synthesize(spec, narrowed);
+    const double zt = narrowed.params.at("zt_ratio");
+    EXPECT_GE(zt, 1.2);
+    EXPECT_LE(zt, 1.5);
+    // The same uniform number, mapped onto the narrower range.
+    const double u = (whole.params.at("zt_ratio") - 1.2) / (8.0 - 1.2);
+    EXPECT_NEAR(zt, 1.2 + 0.3 * u, 1e-12);
+    EXPECT_EQ(narrowed.params.at("r_A"), whole.params.at("r_A"));
+    EXPECT_EQ(narrowed.rig, whole.rig);
+    spec.paramRanges = {{"zt_ratio", {0.9, 1.5}}};
+    EXPECT_THROW(synthesize(spec, narrowed), LabError) << "a range outside the prior reached the simulator";
+}
+
 // The one reading of "is this text a number" behind every command-line value and data field.
 TEST(ReferenceSynthData, AWholeNumberIsAllOfTheTextAndNothingMore)
 {

@@ -271,6 +271,51 @@ TEST(Study, AFixedRigValueReachesEverySetAndThePlan)
     fs::remove_all(dir);
 }
 
+// `rosin study --param-range`: every set that hides the effect draws its size from the range,
+// the plan records it (a folder of the whole prior refuses to resume as a narrowed study), and
+// scoring says so and will not pool it with a study of the whole prior.
+TEST(Study, ANarrowedParameterRangeReachesEverySetThePlanAndThePool)
+{
+    const fs::path dir = freshDir("narrowed"), whole = freshDir("narrowed-whole"), out = freshDir("narrowed-pool");
+    StudyOptions o;
+    o.sets = 6;
+    o.nulls = 0;
+    o.grid = 3;
+    o.seed = 14;
+    o.hiding = "torsional_compliance";
+    o.paramRanges = {{"zt_ratio", {1.2, 2.0}}};
+    o.generateOnly = true;
+    runStudy(dir, o);
+    json plan;
+    std::ifstream(dir / "plan.json") >> plan;
+    EXPECT_EQ(plan["param_ranges"]["zt_ratio"], json({1.2, 2.0}));
+    int rolls = 0;
+    for (int k = 0; k < o.sets; ++k) {
+        if (!fs::exists(setDir(dir, k) / "truth.json")) continue;
+        json truth;
+        std::ifstream(setDir(dir, k) / "truth.json") >> truth;
+        const double zt = truth["params"]["zt_ratio"].get<double>();
+        EXPECT_GE(zt, 1.2) << "set " << k;
+        EXPECT_LE(zt, 2.0) << "set " << k;
+        ++rolls;
+    }
+    EXPECT_GE(rolls, 1) << "seed 14's plan of 6 hides no torsion: pick another seed";
+    o.paramRanges.clear();
+    EXPECT_THROW(runStudy(dir, o), LabError) << "a narrowed study resumed over the whole prior";
+    // Pooled with a study of the whole prior: refused, naming what differs.
+    std::ofstream(whole / "plan.json") << json{{"grid", 3}, {"seed", 15}, {"sets", json::array()}}.dump();
+    fs::create_directories(whole / "sets");
+    try {
+        scoreStudies(out, {dir, whole});
+        ADD_FAILURE() << "a narrowed study was pooled with a whole one";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("parameter ranges"), std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
+    fs::remove_all(whole);
+    fs::remove_all(out);
+}
+
 // --units N: every set is written in newtons through a sensor calibrated to within the rig's
 // calibration error; the plan says so, and a volt study's folder refuses it.
 TEST(Study, ANewtonStudyWritesItsSetsInNewtonsAndItsPlanSaysSo)

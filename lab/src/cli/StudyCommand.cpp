@@ -19,6 +19,7 @@ struct StudyCommand {
     std::string out = "study";
     bool scoreOnly = false;
     std::vector<std::string> rigValues;
+    std::vector<std::string> paramRanges;
     std::vector<std::string> pool;
 
     CLI::App* add(CLI::App& app)
@@ -49,6 +50,9 @@ struct StudyCommand {
         cmd->add_option("--rig-param", rigValues,
                         "Reference rig value NAME=VALUE fixed in every set instead of drawn (names: rosin synth-data --help), e.g. "
                         "inharmonicity=1e-3 for strongly stiff strings");
+        cmd->add_option("--param-range", paramRanges,
+                        "Hidden parameter NAME=LO:HI drawn from this range, inside its prior, instead of the whole prior (names: r_A, h0, p, "
+                        "load_exponent, shift_k as its size, zt_ratio), e.g. zt_ratio=1.2:3 for a study of strongly rolling strings");
         addSearchFlags(*cmd, options.diagnose);
         cmd->add_flag("--keep-sets", options.keepSets, "Keep the generated WAV sets");
         cmd->add_option("--only", options.only, "Run only these sets (indices, e.g. 3,13; the folder's plan stays the whole study)")->delimiter(',')->check(CLI::NonNegativeNumber);
@@ -68,6 +72,7 @@ struct StudyCommand {
     int run()
     {
         options.rig = parseRigValues(rigValues);
+        options.paramRanges = parseParamRanges(paramRanges);
         if (!pool.empty()) {
             if (!Distributed::instance().isRoot()) return 0;
             const std::string summary = scoreStudies(out, std::vector<std::filesystem::path>(pool.begin(), pool.end()));

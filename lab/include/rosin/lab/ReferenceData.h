@@ -35,6 +35,11 @@ std::map<std::string, double> parseRigValues(const std::vector<std::string>& nam
 /// to none: shifts from 1 K, load exponents up to 0.95, Z_t/Z_0 up to 8.
 const std::map<std::string, std::pair<double, double>>& referenceEffectPriors();
 
+/// NAME=LO:HI strings (`--param-range`) to narrowed draws of hidden parameters: each name one of
+/// referenceEffectPriors(), LO < HI, both finite and inside that prior; a clear error otherwise.
+/// For shift_k the range is of its size |shift|; the sign is drawn as before.
+std::map<std::string, std::pair<double, double>> parseParamRanges(const std::vector<std::string>& nameEqualsRange);
+
 MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress = {});
 
 } // namespace rosin::lab

@@ -34,6 +34,9 @@ struct StudyOptions {
     /// Rig values fixed in every set instead of drawn (synth-data --rig-param): a study of rigs
     /// that differ from the model in a way no candidate names, such as a strongly stiff string.
     std::map<std::string, double> rig;
+    /// Hidden parameters drawn from a narrower range than their prior (synth-data's
+    /// paramRanges): a study of effects near their detection limit. Part of the plan.
+    std::map<std::string, std::pair<double, double>> paramRanges;
     bool keepSets = false;     ///< keep the generated WAV sets (regenerable from their seeds)
     bool generateOnly = false; ///< simulate and keep the sets, diagnose none (a later run diagnoses the kept sets)
     /// Run only these planned sets now (by index; empty = all) and only those hiding this effect

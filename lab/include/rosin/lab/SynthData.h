@@ -44,6 +44,9 @@ struct SynthSpec {
     /// rig drawn with every nuisance a lab never knows exactly (ReferenceData.h).
     std::string generator = "model";
     std::map<std::string, double> rig;    ///< reference: rig values fixed instead of drawn (referenceRigKeys())
+    /// reference: a hidden parameter drawn from this range instead of its whole prior (a study
+    /// at the edge of detection); each range lies within referenceEffectPriors().
+    std::map<std::string, std::pair<double, double>> paramRanges;
     int oversampling = 4;                 ///< reference: simulation rate / file rate (>= 4)
     /// reference: guettler (a x F grid), exp_speed (initial acceleration v0/tv x F, v0 fixed),
     /// exp_force (bow speed x F0, tf fixed) or mixed (the three in turn over the grid).
