@@ -134,9 +134,9 @@ void checkParamRange(const std::string& key, double lo, double hi)
     const auto [plo, phi] = prior->second;
     if (lo < plo || hi > phi)
     {
-        char prior[64];
-        std::snprintf(prior, sizeof prior, "%g to %g", plo, phi);
-        throw LabError("--param-range: " + key + " must lie within its prior, " + prior);
+        char within[64];
+        std::snprintf(within, sizeof within, "%g to %g", plo, phi);
+        throw LabError("--param-range: " + key + " must lie within its prior, " + within);
     }
 }
 } // namespace
@@ -156,6 +156,43 @@ std::map<std::string, std::pair<double, double>> parseParamRanges(const std::vec
     return ranges;
 }
 
+namespace {
+/// The rig error a stated uncertainty bounds: tension -> tension_error, beta -> beta_error.
+const RigPrior& statedError(const std::string& name)
+{
+    const std::string key = name + "_error";
+    const auto& pr = referenceRigPriors();
+    const auto it = std::find_if(pr.begin(), pr.end(), [&](const RigPrior& r) { return r.key == key; });
+    if ((name != "tension" && name != "beta") || it == pr.end())
+        throw LabError("--stated-uncertainty: unknown rig value '" + name + "' (tension, beta)");
+    return *it;
+}
+
+void checkStatedUncertainty(const std::string& name, double u)
+{
+    const double spread = statedError(name).hi;
+    if (!std::isfinite(u) || u < 0.001 || u > spread) {
+        char range[96];
+        std::snprintf(range, sizeof range, "a fraction from 0.001 to %g (the generator's own spread of its error)", spread);
+        throw LabError("--stated-uncertainty: " + name + " must be " + range);
+    }
+}
+} // namespace
+
+std::map<std::string, double> parseStatedUncertainties(const std::vector<std::string>& nameEqualsFraction)
+{
+    std::map<std::string, double> stated;
+    for (const auto& kv : nameEqualsFraction) {
+        const auto eq = kv.find('=');
+        if (eq == std::string::npos) throw LabError("--stated-uncertainty: expected NAME=FRACTION (tension=0.01), got '" + kv + "'");
+        const std::optional<double> u = wholeNumber(kv.substr(eq + 1));
+        if (!u) throw LabError("--stated-uncertainty: '" + kv + "' has no number");
+        checkStatedUncertainty(kv.substr(0, eq), *u);
+        stated[kv.substr(0, eq)] = *u;
+    }
+    return stated;
+}
+
 MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress)
 {
     if (spec.grid < 2 || spec.grid > 60) throw LabError("--grid must be within 2..60");
@@ -164,6 +201,7 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     if (spec.units != "V" && spec.units != "N") throw LabError("--units must be V or N");
     for (const auto& [key, value] : spec.rig) checkRigValue(key, value);
     for (const auto& [key, range] : spec.paramRanges) checkParamRange(key, range.first, range.second);
+    for (const auto& [name, u] : spec.statedUncertainty) checkStatedUncertainty(name, u);
     std::mt19937_64 rng(spec.seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     truth = SynthTruth{};
@@ -199,6 +237,10 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         double v = p.logScale ? p.lo * std::pow(p.hi / p.lo, x) : p.lo + (p.hi - p.lo) * x;
         if (p.key == "hum_hz") v = x < 0.2 ? 0.0 : (y < 0.5 ? 50.0 : 60.0);
         if (p.key == "headroom") v = x < 0.2 ? 1.05 + 0.35 * y : 0.3 + 0.6 * y;
+        // A lab that measured its tension or bow position to +-U: the same number of the
+        // stream, mapped onto +-U, so every other draw stays that of the rig it did not measure.
+        for (const auto& [name, stated] : spec.statedUncertainty)
+            if (p.key == name + "_error") v = stated * (2.0 * x - 1.0);
         const auto it = spec.rig.find(p.key);
         rig[p.key] = it != spec.rig.end() ? it->second : v;
     }
@@ -273,6 +315,8 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     set.units = spec.units;
     set.sampleRate = spec.outRate;
     set.gesture = spec.gesture;
+    if (const auto t = spec.statedUncertainty.find("tension"); t != spec.statedUncertainty.end()) set.tensionUncertainty = t->second;
+    if (const auto b = spec.statedUncertainty.find("beta"); b != spec.statedUncertainty.end()) set.betaUncertainty = b->second;
     // The lab's own steady-sliding measurement of this rosin, 1 % scatter.
     {
         std::normal_distribution<double> g(0.0, 1.0);

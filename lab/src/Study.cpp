@@ -77,6 +77,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     if (o.units == "N" && o.gesture != "exp_force") planJson["units"] = "N"; // and volt studies
     if (!o.rig.empty()) planJson["rig"] = o.rig;                   // fixed rig values: part of the study
     for (const auto& [key, range] : o.paramRanges) planJson["param_ranges"][key] = {range.first, range.second}; // and narrowed draws
+    if (!o.statedUncertainty.empty()) planJson["stated_uncertainty"] = o.statedUncertainty;      // and what the labs state
     // A folder resumes only the study it holds: sets are skipped by folder name, so a different
     // seed, size or grid would silently mix two studies.
     if (fs::exists(dir / "plan.json")) {
@@ -87,7 +88,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
         }
         if (before != planJson)
-            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture, units, fixed rig values, narrowed parameter ranges or plan version: "
+            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture, units, fixed rig values, narrowed parameter ranges, stated uncertainties or plan version: "
                                                           "a plan.json without \"plan\" is version 1, --plan 1); use a new folder");
     }
     fs::create_directories(dir / "sets");
@@ -128,6 +129,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         spec.gesture = o.gesture;
         spec.rig = o.rig;
         spec.paramRanges = o.paramRanges;
+        spec.statedUncertainty = o.statedUncertainty;
         spec.units = o.gesture == "exp_force" ? "N" : o.units;
         if (!kept) {
             SynthTruth truth;

@@ -157,7 +157,7 @@ json readPlan(const fs::path& dir)
 json populationOf(const json& plan)
 {
     json p;
-    for (const char* key : {"grid", "gesture", "units", "rig", "param_ranges"})
+    for (const char* key : {"grid", "gesture", "units", "rig", "param_ranges", "stated_uncertainty"})
         if (plan.contains(key)) p[key] = plan[key];
     return p;
 }
@@ -246,7 +246,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         const json here = readPlan(study);
         if (populationOf(here) != populationOf(plan))
             throw LabError(study.string() + "/plan.json: " + populationOf(here).dump() + " where " + studies.front().string() + " has " +
-                           populationOf(plan).dump() + ": studies scored together must share the grid, gesture, units, fixed rig values and parameter ranges");
+                           populationOf(plan).dump() + ": studies scored together must share the grid, gesture, units, fixed rig values, parameter ranges and stated uncertainties");
         const std::size_t before = sets.size();
         std::vector<fs::path> folders;
         for (const auto& e : fs::directory_iterator(study / "sets")) folders.push_back(e.path());
@@ -341,6 +341,14 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         md << "Hidden parameters drawn from narrowed ranges, not their whole priors: " << narrowed
            << ". Detection rates here describe those sizes only, not the study population.\n";
         summary["param_ranges"] = plan["param_ranges"];
+    }
+    if (plan.contains("stated_uncertainty")) {
+        std::string stated;
+        for (const auto& [k, v] : plan["stated_uncertainty"].items())
+            stated += (stated.empty() ? "" : ", ") + k + fmt(" +-%.3g %%", 100.0 * v.get<double>());
+        md << "Rigs of a lab that states what it measured: " << stated
+           << " in every manifest, each rig's error drawn within it (the generator's own spread: tension +-4 %, bow position +-3 %).\n";
+        summary["stated_uncertainty"] = plan["stated_uncertainty"];
     }
     md << "\n";
     summary["unexplained_residual"] = {

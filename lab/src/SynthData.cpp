@@ -81,6 +81,7 @@ MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::f
     if (spec.generator == "reference") return synthesizeReference(spec, truth, progress);
     if (spec.generator != "model") throw LabError("--generator must be model or reference");
     if (!spec.rig.empty()) throw LabError("--rig-param applies to --generator reference only");
+    if (!spec.statedUncertainty.empty()) throw LabError("--stated-uncertainty applies to --generator reference only");
     if (spec.gesture != "guettler") throw LabError("--gesture applies to --generator reference only");
     if (spec.grid < 2 || spec.grid > 60) throw LabError("--grid must be within 2..60");
     if (!(spec.outRate >= 8000 && spec.outRate <= 384000)) throw LabError("--rate must be within 8000..384000 Hz");

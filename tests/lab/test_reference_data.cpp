@@ -203,6 +203,69 @@ TEST(ReferenceSynthData, ANarrowedRangeMovesOnlyItsOwnParameter)
     EXPECT_THROW(synthesize(spec, narrowed), LabError) << "a range outside the prior reached the simulator";
 }
 
+// --stated-uncertainty: a lab's statement of what it measured names tension or beta and a
+// fraction that a manifest accepts and that is no wider than the generator's own spread.
+TEST(ReferenceSynthData, StatedUncertaintiesAreParsedOrRefusedByName)
+{
+    const auto stated = parseStatedUncertainties({"tension=0.01", "beta=0.005"});
+    ASSERT_EQ(stated.size(), 2u);
+    EXPECT_EQ(stated.at("tension"), 0.01);
+    EXPECT_EQ(stated.at("beta"), 0.005);
+    const auto refusal = [](const std::vector<std::string>& args) {
+        try {
+            parseStatedUncertainties(args);
+        } catch (const LabError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_NE(refusal({"length=0.01"}).find("unknown rig value 'length' (tension, beta)"), std::string::npos);
+    EXPECT_NE(refusal({"tension_error=0.01"}).find("unknown rig value"), std::string::npos);
+    EXPECT_NE(refusal({"tension"}).find("expected NAME=FRACTION"), std::string::npos);
+    EXPECT_NE(refusal({"tension=1%"}).find("has no number"), std::string::npos);
+    EXPECT_NE(refusal({"tension=0.05"}).find("tension must be a fraction from 0.001 to 0.04"), std::string::npos);
+    EXPECT_NE(refusal({"beta=0.035"}).find("beta must be a fraction from 0.001 to 0.03"), std::string::npos);
+    EXPECT_NE(refusal({"beta=0.0005"}).find("from 0.001"), std::string::npos);
+    EXPECT_NE(refusal({"beta=nan"}).find("beta must be"), std::string::npos);
+}
+
+// A lab that measured its tension to +-1 % and its bow position to +-0.5 %: the rig's errors
+// fall within that, drawn from the same stream numbers as the unmeasured rig (every other rig
+// value unchanged), and the manifest written and read back states both.
+TEST(ReferenceSynthData, AStatedUncertaintyBoundsTheRigsErrorAndTheManifestSaysIt)
+{
+    SynthSpec spec = small(33);
+    spec.effects = {"torsional_compliance"};
+    SynthTruth unmeasured, measured;
+    const MeasurementSet plain = synthesize(spec, unmeasured);
+    EXPECT_FALSE(plain.tensionUncertainty.has_value());
+    spec.statedUncertainty = {{"tension", 0.01}, {"beta", 0.005}};
+    const MeasurementSet set = synthesize(spec, measured);
+    EXPECT_NEAR(measured.rig.at("tension_error"), unmeasured.rig.at("tension_error") * 0.01 / 0.04, 1e-15);
+    EXPECT_NEAR(measured.rig.at("beta_error"), unmeasured.rig.at("beta_error") * 0.005 / 0.03, 1e-15);
+    EXPECT_LE(std::abs(measured.rig.at("tension_error")), 0.01);
+    EXPECT_LE(std::abs(measured.rig.at("beta_error")), 0.005);
+    EXPECT_NEAR(measured.rig.at("tension_n") / 102.6 - 1.0, measured.rig.at("tension_error"), 1e-12);
+    for (const auto& [key, value] : unmeasured.rig) {
+        const bool follows = key == "tension_error" || key == "beta_error" || key == "tension_n" || key == "beta" || key == "z0_kg_per_s" || key == "cells";
+        if (!follows) {
+            EXPECT_EQ(measured.rig.at(key), value) << key << " moved";
+        }
+    }
+    EXPECT_EQ(measured.params, unmeasured.params);
+    const fs::path dir = fresh("stated");
+    writeMeasurementSet(dir / "set", set, SF_FORMAT_FLOAT);
+    const MeasurementSet back = readMeasurementSet(dir / "set");
+    fs::remove_all(dir);
+    ASSERT_TRUE(back.tensionUncertainty.has_value());
+    ASSERT_TRUE(back.betaUncertainty.has_value());
+    EXPECT_DOUBLE_EQ(*back.tensionUncertainty, 0.01);
+    EXPECT_DOUBLE_EQ(*back.betaUncertainty, 0.005);
+    EXPECT_DOUBLE_EQ(*back.tension, 102.6) << "the manifest keeps the nominal tension";
+    spec.generator = "model";
+    EXPECT_THROW(synthesize(spec, measured), LabError) << "the model generator has no rig to measure";
+}
+
 // The one reading of "is this text a number" behind every command-line value and data field.
 TEST(ReferenceSynthData, AWholeNumberIsAllOfTheTextAndNothingMore)
 {

@@ -316,6 +316,47 @@ TEST(Study, ANarrowedParameterRangeReachesEverySetThePlanAndThePool)
     fs::remove_all(out);
 }
 
+// `rosin study --stated-uncertainty`: every set's manifest states what its lab measured and its
+// rig's error lies within it; the plan records it, a folder of unmeasured rigs refuses it, and a
+// pool with unmeasured rigs is refused naming what differs.
+TEST(Study, StatedUncertaintiesReachEverySetThePlanAndThePool)
+{
+    const fs::path dir = freshDir("stated"), whole = freshDir("stated-whole"), out = freshDir("stated-pool");
+    StudyOptions o;
+    o.sets = 2;
+    o.nulls = 1;
+    o.grid = 3;
+    o.seed = 16;
+    o.statedUncertainty = {{"tension", 0.01}, {"beta", 0.01}};
+    o.generateOnly = true;
+    runStudy(dir, o);
+    json plan;
+    std::ifstream(dir / "plan.json") >> plan;
+    EXPECT_EQ(plan["stated_uncertainty"], json({{"beta", 0.01}, {"tension", 0.01}}));
+    for (int k = 0; k < o.sets; ++k) {
+        json truth, manifest;
+        std::ifstream(setDir(dir, k) / "truth.json") >> truth;
+        std::ifstream(setDir(dir, k) / "set" / "manifest.json") >> manifest;
+        EXPECT_LE(std::abs(truth["rig"]["tension_error"].get<double>()), 0.01) << "set " << k;
+        EXPECT_LE(std::abs(truth["rig"]["beta_error"].get<double>()), 0.01) << "set " << k;
+        EXPECT_EQ(manifest["rig"]["string"]["tension_uncertainty"], 0.01) << "set " << k;
+        EXPECT_EQ(manifest["rig"]["beta_uncertainty"], 0.01) << "set " << k;
+    }
+    o.statedUncertainty.clear();
+    EXPECT_THROW(runStudy(dir, o), LabError) << "a study of measured rigs resumed as one of unmeasured rigs";
+    std::ofstream(whole / "plan.json") << json{{"grid", 3}, {"seed", 17}, {"sets", json::array()}}.dump();
+    fs::create_directories(whole / "sets");
+    try {
+        scoreStudies(out, {dir, whole});
+        ADD_FAILURE() << "measured rigs were pooled with unmeasured ones";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("stated uncertainties"), std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
+    fs::remove_all(whole);
+    fs::remove_all(out);
+}
+
 // --units N: every set is written in newtons through a sensor calibrated to within the rig's
 // calibration error; the plan says so, and a volt study's folder refuses it.
 TEST(Study, ANewtonStudyWritesItsSetsInNewtonsAndItsPlanSaysSo)

@@ -20,6 +20,7 @@ struct StudyCommand {
     bool scoreOnly = false;
     std::vector<std::string> rigValues;
     std::vector<std::string> paramRanges;
+    std::vector<std::string> statedUncertainties;
     std::vector<std::string> pool;
 
     CLI::App* add(CLI::App& app)
@@ -53,6 +54,9 @@ struct StudyCommand {
         cmd->add_option("--param-range", paramRanges,
                         "Hidden parameter NAME=LO:HI drawn from this range, inside its prior, instead of the whole prior (names: r_A, h0, p, "
                         "load_exponent, shift_k as its size, zt_ratio), e.g. zt_ratio=1.2:3 for a study of strongly rolling strings");
+        cmd->add_option("--stated-uncertainty", statedUncertainties,
+                        "Rigs of a lab that measured them, NAME=FRACTION (tension, beta): each rig's error is drawn within +-FRACTION "
+                        "and its manifest states it, e.g. tension=0.01 beta=0.01");
         addSearchFlags(*cmd, options.diagnose);
         cmd->add_flag("--keep-sets", options.keepSets, "Keep the generated WAV sets");
         cmd->add_option("--only", options.only, "Run only these sets (indices, e.g. 3,13; the folder's plan stays the whole study)")->delimiter(',')->check(CLI::NonNegativeNumber);
@@ -62,7 +66,7 @@ struct StudyCommand {
         cmd->add_flag("--score-only", scoreOnly, "Only score what OUT already holds");
         cmd->add_option("--pool", pool,
                         "Score these finished studies (folders) together into OUT, as one study of all their sets; runs no set. They must "
-                        "share grid, gesture, units and fixed rig values, and OUT must be none of them")
+                        "share grid, gesture, units, fixed rig values, parameter ranges and stated uncertainties, and OUT must be none of them")
             ->check(CLI::ExistingDirectory)
             ->excludes("--only", "--hiding", "--generate-only", "--keep-sets", "--score-only");
         cmd->add_flag("-q,--quiet", options.quiet, "No progress and no summary");
@@ -73,6 +77,7 @@ struct StudyCommand {
     {
         options.rig = parseRigValues(rigValues);
         options.paramRanges = parseParamRanges(paramRanges);
+        options.statedUncertainty = parseStatedUncertainties(statedUncertainties);
         if (!pool.empty()) {
             if (!Distributed::instance().isRoot()) return 0;
             const std::string summary = scoreStudies(out, std::vector<std::filesystem::path>(pool.begin(), pool.end()));

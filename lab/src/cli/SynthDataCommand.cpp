@@ -32,7 +32,7 @@ namespace {
 struct SynthDataCommand {
     SynthSpec synth;
     std::string synthOut = "set", wavKind = "pcm24";
-    std::vector<std::string> synthParams, rigParams;
+    std::vector<std::string> synthParams, rigParams, statedUncertainties;
     bool synthQuiet = false;
 
     CLI::App* add(CLI::App& app)
@@ -50,6 +50,9 @@ struct SynthDataCommand {
                          "resonances, exact-kernel heat) on a rig drawn from the seed; --rig-param fixes a value:\n" + rigKeys);
         synthCmd->add_option("--generator", synth.generator, "model or reference")->check(CLI::IsMember({"model", "reference"}))->capture_default_str();
         synthCmd->add_option("--rig-param", rigParams, "Reference rig value NAME=VALUE instead of a drawn one (see below)");
+        synthCmd->add_option("--stated-uncertainty", statedUncertainties,
+                             "Reference: a lab that measured its rig, NAME=FRACTION (tension, beta): the rig's error is drawn within "
+                             "+-FRACTION and the manifest states it");
         synthCmd->add_option("--oversampling", synth.oversampling, "Reference: simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         synthCmd->add_option("--gesture", synth.gesture, "Reference: guettler, exp_speed (v0/tv x F), exp_force (speed x F0) or mixed")
             ->check(CLI::IsMember({"guettler", "exp_speed", "exp_force", "mixed"}))->capture_default_str();
@@ -89,6 +92,7 @@ struct SynthDataCommand {
             synth.params[key] = *value;
         }
         synth.rig = parseRigValues(rigParams);
+        synth.statedUncertainty = parseStatedUncertainties(statedUncertainties);
         if (fs::exists(synthOut)) throw LabError(synthOut + ": already exists (choose a new folder)");
         const std::map<std::string, int> formats{{"pcm16", SF_FORMAT_PCM_16}, {"pcm24", SF_FORMAT_PCM_24},
                                                  {"pcm32", SF_FORMAT_PCM_32}, {"float", SF_FORMAT_FLOAT},

@@ -40,6 +40,12 @@ const std::map<std::string, std::pair<double, double>>& referenceEffectPriors();
 /// For shift_k the range is of its size |shift|; the sign is drawn as before.
 std::map<std::string, std::pair<double, double>> parseParamRanges(const std::vector<std::string>& nameEqualsRange);
 
+/// NAME=U strings (`--stated-uncertainty`) for a lab that measured its rig: names tension and
+/// beta, U a fraction either way from 0.001 (what a manifest accepts) to the generator's own
+/// spread of that error (0.04, 0.03). The rig's error is then drawn within +-U and the manifest
+/// states U (rig.string.tension_uncertainty, rig.beta_uncertainty); a clear error otherwise.
+std::map<std::string, double> parseStatedUncertainties(const std::vector<std::string>& nameEqualsFraction);
+
 MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress = {});
 
 } // namespace rosin::lab

@@ -37,6 +37,9 @@ struct StudyOptions {
     /// Hidden parameters drawn from a narrower range than their prior (synth-data's
     /// paramRanges): a study of effects near their detection limit. Part of the plan.
     std::map<std::string, std::pair<double, double>> paramRanges;
+    /// Rigs whose lab states its tension and bow position to +-U (synth-data's
+    /// statedUncertainty): what a better-measured rig can name. Part of the plan.
+    std::map<std::string, double> statedUncertainty;
     bool keepSets = false;     ///< keep the generated WAV sets (regenerable from their seeds)
     bool generateOnly = false; ///< simulate and keep the sets, diagnose none (a later run diagnoses the kept sets)
     /// Run only these planned sets now (by index; empty = all) and only those hiding this effect

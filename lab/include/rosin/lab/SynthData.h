@@ -47,6 +47,9 @@ struct SynthSpec {
     /// reference: a hidden parameter drawn from this range instead of its whole prior (a study
     /// at the edge of detection); each range lies within referenceEffectPriors().
     std::map<std::string, std::pair<double, double>> paramRanges;
+    /// reference: what the lab states it knows of its rig ("tension", "beta": +-fraction): the
+    /// error is drawn within it and the manifest says so (parseStatedUncertainties()).
+    std::map<std::string, double> statedUncertainty;
     int oversampling = 4;                 ///< reference: simulation rate / file rate (>= 4)
     /// reference: guettler (a x F grid), exp_speed (initial acceleration v0/tv x F, v0 fixed),
     /// exp_force (bow speed x F0, tf fixed) or mixed (the three in turn over the grid).
