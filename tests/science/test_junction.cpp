@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <random>
+#include <ostream>
+#include <string>
 
 #include "RandomGesture.h"
 #include "TestSupport.h"
@@ -16,6 +18,15 @@ struct Case {
     bool torsion;
     ContactLaw contact;
 };
+
+std::string caseName(const Case& k)
+{
+    const char* model = k.model == FrictionModel::FrictionCurve ? "FrictionCurve" : k.model == FrictionModel::Thermal ? "Thermal" : "Enhanced";
+    return std::string(model) + (k.torsion ? "_Torsion" : "") + (k.contact == ContactLaw::Amontons ? "_Amontons" : "_Hertzian");
+}
+
+// ctest takes the printed parameter into the test's name: printed from its fields, not its bytes.
+void PrintTo(const Case& k, std::ostream* os) { *os << caseName(k); }
 } // namespace
 
 class JunctionEquation : public ::testing::TestWithParam<Case> {};
@@ -70,7 +81,10 @@ INSTANTIATE_TEST_SUITE_P(AllModels, JunctionEquation,
                                            Case{FrictionModel::Thermal, false, ContactLaw::Amontons},
                                            Case{FrictionModel::Thermal, true, ContactLaw::PowerLaw},
                                            Case{FrictionModel::Enhanced, false, ContactLaw::Amontons},
-                                           Case{FrictionModel::Enhanced, true, ContactLaw::PowerLaw}));
+                                           Case{FrictionModel::Enhanced, true, ContactLaw::PowerLaw}),
+                         // Names from the case, not from its bytes: gtest would print the struct's
+                         // padding, which differs from build to build and so renamed the ctest tests.
+                         [](const ::testing::TestParamInfo<Case>& param) { return caseName(param.param); });
 
 // The thermal junction skips work where it can: sticking samples that stay below the limit of
 // a lookup at a warmer temperature do not read the table, and a contact that was still takes
