@@ -89,7 +89,7 @@ std::vector<RigUnknown> rigUnknowns(const EffectModel& m)
     // move carries as every fit does: Engine::rampSoftening), which p and the load exponent take
     // up. Z_t/Z_0 = 2 is a string that rolls readily (the reference rigs draw 1.2-8).
     if (!has(m.effects, "torsional_compliance"))
-        out.push_back({"torsion", "torsion at Z_t/Z_0 = 2", {"torsional_compliance"}, {{"zt_ratio", 2.0}}});
+        out.push_back({"torsion", "torsion at Z_t/Z_0 = 2", {"torsional_compliance"}, {{"zt_ratio", kReadilyRollingZt}}});
     return out;
 }
 

@@ -90,6 +90,10 @@ bool clearOfNoEffect(const Finding& f, const std::string& name);
 double assumedTorsionSpeedRatio();
 /// A rolling string's softening of the bow point (rollingSoftening) in the lab's model at this Z_t/Z_0.
 double softeningAt(double ztRatio);
+/// A string that rolls readily (reference rigs draw Z_t/Z_0 1.2-8): the roll a model without
+/// torsion is tried against as a rig unknown, whose softening a free ramp scale starts from and
+/// which the reported scale's interval leaves room for when no torsion is named.
+constexpr double kReadilyRollingZt = 2.0;
 /// A named torsion's softening at its value and at the ends of its reported Z_t/Z_0 interval.
 std::array<double, 3> rollingSofteningOf(const Finding& f);
 /// What a finding's numbers can and cannot say beyond its table, in plain words for report.md:

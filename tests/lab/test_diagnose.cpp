@@ -160,6 +160,11 @@ void check(const Case& k)
     EXPECT_EQ(scale->value, d.scale);
     EXPECT_LE(scale->low, 1.0 / truth.gain);
     EXPECT_GE(scale->high, 1.0 / truth.gain);
+    // Without a named torsion the low end leaves room for a roll no model named (Z_t/Z_0 = 2, the
+    // rig unknown's); a named torsion has taken its own softening into the value instead.
+    const bool roomForARoll = scale->meaning.find("a roll of Z_t/Z_0 = 2 that no model named") != std::string::npos;
+    EXPECT_EQ(roomForARoll, !torsion) << scale->meaning;
+    if (!torsion) EXPECT_LE(scale->low, d.scale * diag::softeningAt(diag::kReadilyRollingZt) * (1.0 + 1e-12));
 }
 } // namespace
 
