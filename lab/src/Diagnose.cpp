@@ -179,8 +179,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                       "The ramps' sensor scale assumes a string that does not roll: the share of it that a roll the model lacks would "
                       "take (ramp_softening, %.3f-1) is calibrated with tension and bow position and free in every model without "
                       "torsion (a model with torsion makes its own); round 1 searches each candidate again from %.3f, a roll of "
-                      "Z_t/Z_0 = 2. The reported scale takes it.",
-                      parameterBounds().at("ramp_softening").first, softeningAt(kReadilyRollingZt));
+                      "Z_t/Z_0 = %g. The reported scale takes it.",
+                      parameterBounds().at("ramp_softening").first, softeningAt(kReadilyRollingZt), kReadilyRollingZt);
         d.rules.push_back(text);
     }
     if (o.usualResidualRatio > 0.0) d.rules.push_back(standInRuleText(o.usualResidualRatio));

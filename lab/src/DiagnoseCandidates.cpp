@@ -88,8 +88,11 @@ std::vector<RigUnknown> rigUnknowns(const EffectModel& m)
     // yet a rolling string softens the pre-slip ramp (and inflates a ramp-read scale, which the
     // move carries as every fit does: Engine::rampSoftening), which p and the load exponent take
     // up. Z_t/Z_0 = 2 is a string that rolls readily (the reference rigs draw 1.2-8).
-    if (!has(m.effects, "torsional_compliance"))
-        out.push_back({"torsion", "torsion at Z_t/Z_0 = 2", {"torsional_compliance"}, {{"zt_ratio", kReadilyRollingZt}}});
+    if (!has(m.effects, "torsional_compliance")) {
+        char setting[48];
+        std::snprintf(setting, sizeof setting, "torsion at Z_t/Z_0 = %g", kReadilyRollingZt);
+        out.push_back({"torsion", setting, {"torsional_compliance"}, {{"zt_ratio", kReadilyRollingZt}}});
+    }
     return out;
 }
 
