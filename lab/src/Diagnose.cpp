@@ -548,37 +548,39 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     //    were, so the reported scale takes that factor (the final model's, at its own Z_t/Z_0).
     //    A free ramp_softening (--free-ramp-scale) is that factor for a roll the model lacks.
     //    Its interval carries ramp_softening's own.
+    //    Without a named torsion, a roll no model named would read the ramps' scale 1/s too large,
+    //    and a volt set cannot tell (seed 2061: 22 missed rolls of Z_t/Z_0 1.2-3 read it 0.6 to
+    //    14.6 % high; with tension and bow position stated to +-1 % the interval then held the
+    //    rig's scale on 11 of 29 sets). So the interval's low end leaves room for the rig
+    //    unknown's roll, as every finding's interval does, unless ramp_softening is free.
     const double softer = engine.rampSoftening(d.final);
     std::array<double, 2> softerRange{softer, softer};
+    bool softeningFree = false;
     for (const auto& c : d.calibration)
-        if (c.name == "ramp_softening" && c.value > 0.0) softerRange = {softer * c.low / c.value, softer * c.high / c.value};
-    if (softer < 1.0 || softerRange[0] < softer) {
-        d.scale *= softer;
-        for (auto& c : d.calibration)
-            if (c.name == "scale_n_per_unit") {
-                c.value *= softer;
-                c.low *= softerRange[0];
-                c.high *= softerRange[1];
-                char note[96];
-                std::snprintf(note, sizeof note, "; times %.3f, the ramps' softening by a rolling string", softer);
-                c.meaning += note;
-            }
+        if (c.name == "ramp_softening") {
+            softeningFree = true;
+            if (c.value > 0.0) softerRange = {softer * c.low / c.value, softer * c.high / c.value};
+        }
+    const bool rolled = softer < 1.0 || softerRange[0] < softer;
+    const bool roomForARoll = engine.scaleFromRamps() && !has(d.final.effects, "torsional_compliance") && !softeningFree;
+    if (rolled) d.scale *= softer;
+    for (auto& c : d.calibration) {
+        if (c.name != "scale_n_per_unit") continue;
+        char note[128];
+        if (rolled) {
+            c.value *= softer;
+            c.low *= softerRange[0];
+            c.high *= softerRange[1];
+            std::snprintf(note, sizeof note, "; times %.3f, the ramps' softening by a rolling string", softer);
+            c.meaning += note;
+        }
+        if (roomForARoll) {
+            const double s = softeningAt(kReadilyRollingZt);
+            c.low *= s;
+            std::snprintf(note, sizeof note, "; its low end times %.3f, the softening of a roll of Z_t/Z_0 = %g that no model named", s, kReadilyRollingZt);
+            c.meaning += note;
+        }
     }
-    //    A roll no model named reads the ramps' scale 1/s too large, and a volt set cannot tell
-    //    (seed 2061: 22 missed rolls of Z_t/Z_0 1.2-3 read it 0.6 to 14.6 % high; with tension and
-    //    bow position stated to +-1 % the interval then held the rig's scale on 11 of 29 sets).
-    //    So without a named torsion the interval's low end leaves room for the rig unknown's
-    //    roll, as every finding's interval does; a free ramp_softening carries its own.
-    const bool softeningFree = std::any_of(d.calibration.begin(), d.calibration.end(), [](const CalibrationValue& c) { return c.name == "ramp_softening"; });
-    if (engine.scaleFromRamps() && !has(d.final.effects, "torsional_compliance") && !softeningFree)
-        for (auto& c : d.calibration)
-            if (c.name == "scale_n_per_unit") {
-                const double s = softeningAt(kReadilyRollingZt);
-                c.low *= s;
-                char note[128];
-                std::snprintf(note, sizeof note, "; its low end times %.3f, the softening of a roll of Z_t/Z_0 = %g that no model named", s, kReadilyRollingZt);
-                c.meaning += note;
-            }
     // 6. Two-ended steady strokes: bow-point velocity and friction reconstructed from the end
     //    forces, measured and as the final model would show them.
     d.loops = compareTwoEnded(set, info, engine, d.final, d.scale, o, [&](const std::string& what) { say(what, 0.0); });

@@ -107,18 +107,26 @@ void checkRigValue(const std::string& key, double value)
         throw LabError("--rig-param: unknown rig value '" + key + "' (rosin synth-data --help lists them)");
     if (!std::isfinite(value)) throw LabError("--rig-param: " + key + " must be a finite number");
 }
+
+/// One NAME=NUMBER argument of a flag, split and read: a clear error naming the flag when it has
+/// no '=' (`form` says what was expected) or no number. The name is the caller's to check.
+std::pair<std::string, double> nameAndNumber(const std::string& flag, const std::string& kv, const std::string& form)
+{
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) throw LabError(flag + ": expected " + form + ", got '" + kv + "'");
+    const std::optional<double> value = wholeNumber(kv.substr(eq + 1));
+    if (!value) throw LabError(flag + ": '" + kv + "' has no number");
+    return {kv.substr(0, eq), *value};
+}
 } // namespace
 
 std::map<std::string, double> parseRigValues(const std::vector<std::string>& nameEqualsValue)
 {
     std::map<std::string, double> rig;
     for (const auto& kv : nameEqualsValue) {
-        const auto eq = kv.find('=');
-        if (eq == std::string::npos) throw LabError("--rig-param: expected NAME=VALUE, got '" + kv + "'");
-        const std::optional<double> value = wholeNumber(kv.substr(eq + 1));
-        if (!value) throw LabError("--rig-param: '" + kv + "' has no number");
-        checkRigValue(kv.substr(0, eq), *value);
-        rig[kv.substr(0, eq)] = *value;
+        const auto [key, value] = nameAndNumber("--rig-param", kv, "NAME=VALUE");
+        checkRigValue(key, value);
+        rig[key] = value;
     }
     return rig;
 }
@@ -183,12 +191,9 @@ std::map<std::string, double> parseStatedUncertainties(const std::vector<std::st
 {
     std::map<std::string, double> stated;
     for (const auto& kv : nameEqualsFraction) {
-        const auto eq = kv.find('=');
-        if (eq == std::string::npos) throw LabError("--stated-uncertainty: expected NAME=FRACTION (tension=0.01), got '" + kv + "'");
-        const std::optional<double> u = wholeNumber(kv.substr(eq + 1));
-        if (!u) throw LabError("--stated-uncertainty: '" + kv + "' has no number");
-        checkStatedUncertainty(kv.substr(0, eq), *u);
-        stated[kv.substr(0, eq)] = *u;
+        const auto [name, u] = nameAndNumber("--stated-uncertainty", kv, "NAME=FRACTION (tension=0.01)");
+        checkStatedUncertainty(name, u);
+        stated[name] = u;
     }
     return stated;
 }

@@ -28,6 +28,18 @@ SynthSpec small(std::uint64_t seed)
     return s;
 }
 
+/// What a command-line parser says when it refuses these arguments ("accepted" when it does not).
+template <class Parse>
+std::string refusalOf(Parse parse, const std::vector<std::string>& args)
+{
+    try {
+        parse(args);
+    } catch (const LabError& e) {
+        return std::string(e.what());
+    }
+    return std::string("accepted");
+}
+
 fs::path fresh(const std::string& name)
 {
     const fs::path dir = fs::temp_directory_path() / ("rosin-refdata-" + std::to_string(::getpid()) + "-" + name);
@@ -139,14 +151,7 @@ TEST(ReferenceSynthData, RigValuesFromTheCommandLineAreParsedOrRefusedByName)
     ASSERT_EQ(rig.size(), 2u);
     EXPECT_DOUBLE_EQ(rig.at("inharmonicity"), 1e-3);
     EXPECT_DOUBLE_EQ(rig.at("bridge_z0y"), 0.25);
-    const auto refusal = [](const std::vector<std::string>& args) {
-        try {
-            parseRigValues(args);
-        } catch (const LabError& e) {
-            return std::string(e.what());
-        }
-        return std::string("accepted");
-    };
+    const auto refusal = [](const std::vector<std::string>& args) { return refusalOf(parseRigValues, args); };
     EXPECT_NE(refusal({"stiffness=1e-3"}).find("unknown rig value 'stiffness'"), std::string::npos);
     EXPECT_NE(refusal({"inharmonicity"}).find("expected NAME=VALUE"), std::string::npos);
     EXPECT_NE(refusal({"inharmonicity=1e-3x"}).find("has no number"), std::string::npos);
@@ -162,14 +167,7 @@ TEST(ReferenceSynthData, ParameterRangesAreParsedOrRefusedByName)
     ASSERT_EQ(ranges.size(), 2u);
     EXPECT_EQ(ranges.at("zt_ratio"), std::make_pair(1.2, 3.0));
     EXPECT_EQ(ranges.at("shift_k"), std::make_pair(10.0, 20.0));
-    const auto refusal = [](const std::vector<std::string>& args) {
-        try {
-            parseParamRanges(args);
-        } catch (const LabError& e) {
-            return std::string(e.what());
-        }
-        return std::string("accepted");
-    };
+    const auto refusal = [](const std::vector<std::string>& args) { return refusalOf(parseParamRanges, args); };
     EXPECT_NE(refusal({"zt=1.2:3"}).find("unknown parameter 'zt'"), std::string::npos);
     EXPECT_NE(refusal({"zt_ratio=1.2"}).find("expected NAME=LO:HI"), std::string::npos);
     EXPECT_NE(refusal({"zt_ratio"}).find("expected NAME=LO:HI"), std::string::npos);
@@ -211,14 +209,7 @@ TEST(ReferenceSynthData, StatedUncertaintiesAreParsedOrRefusedByName)
     ASSERT_EQ(stated.size(), 2u);
     EXPECT_EQ(stated.at("tension"), 0.01);
     EXPECT_EQ(stated.at("beta"), 0.005);
-    const auto refusal = [](const std::vector<std::string>& args) {
-        try {
-            parseStatedUncertainties(args);
-        } catch (const LabError& e) {
-            return std::string(e.what());
-        }
-        return std::string("accepted");
-    };
+    const auto refusal = [](const std::vector<std::string>& args) { return refusalOf(parseStatedUncertainties, args); };
     EXPECT_NE(refusal({"length=0.01"}).find("unknown rig value 'length' (tension, beta)"), std::string::npos);
     EXPECT_NE(refusal({"tension_error=0.01"}).find("unknown rig value"), std::string::npos);
     EXPECT_NE(refusal({"tension"}).find("expected NAME=FRACTION"), std::string::npos);
