@@ -134,8 +134,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     EffectModel current;
     if (o.fitNuisances) {
         say("calibration: tension and bow position", 0.0);
-        Candidate cal = o.freeRampScale && engine.scaleFromRamps() ? candidate("calibration", {"tension_scale", "beta_scale", "ramp_softening"}, {1.0, 1.0, 1.0})
-                                                                   : candidate("calibration", {"tension_scale", "beta_scale"}, {1.0, 1.0});
+        Candidate cal = candidate("calibration", {"tension_scale", "beta_scale"}, {1.0, 1.0});
         cal.adds.clear(); // calibration is not an effect
         const auto x = diag::fit(engine, current, cal, fitSet, cal.start, o.maxEvaluations, 0.2);
         current = apply(current, cal, x);
@@ -173,16 +172,6 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                           "(one r_A), from the grid and from where their own fits that round left them; the pair names both only when its "
                           "validation error is also below each of the two alone, fitted in that round, by the naming threshold, and rules 2-5 "
                           "hold for all its parameters.");
-    if (o.freeRampScale && engine.scaleFromRamps()) {
-        char text[400];
-        std::snprintf(text, sizeof text,
-                      "The ramps' sensor scale assumes a string that does not roll: the share of it that a roll the model lacks would "
-                      "take (ramp_softening, %.3f-1) is calibrated with tension and bow position and free in every model without "
-                      "torsion (a model with torsion makes its own); round 1 searches each candidate again from %.3f, a roll of "
-                      "Z_t/Z_0 = %g. The reported scale takes it.",
-                      parameterBounds().at("ramp_softening").first, softeningAt(kReadilyRollingZt), kReadilyRollingZt);
-        d.rules.push_back(text);
-    }
     if (o.usualResidualRatio > 0.0) d.rules.push_back(standInRuleText(o.usualResidualRatio));
 
     // 4. From the calibrated baseline, add effects one round at a time.
@@ -246,14 +235,6 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             // error 0.124 at exponent 0.78, where the contact-and-roll pair's search reached 0.104
             // at 0.68 with no roll): search again from where it ended, with a wider first step.
             if (o.restartContact && round > 1 && c.effect == "hertzian_contact") searchAgain(base, c, x, o.maxEvaluations, 0.35, x, fitError);
-            // A free ramp scale stays where calibration left it (the baseline cannot tell a roll's
-            // scale from none, and COBYLA barely moves it): round 1 searches each candidate again
-            // from where it ended with the ramps softened as a roll of Z_t/Z_0 = 2 softens them.
-            if (const auto k = std::find(c.names.begin(), c.names.end(), "ramp_softening"); round == 1 && k != c.names.end()) {
-                std::vector<double> from = x;
-                from[static_cast<std::size_t>(k - c.names.begin())] = softeningAt(kReadilyRollingZt);
-                searchAgain(base, c, from, o.maxEvaluations, 0.2, x, fitError);
-            }
             return x;
         };
         auto passesRuleOne = [&](const Tried& t) { return t.gain[1] > 0.0 && d.trials[t.trial].relativeGain >= o.namingThreshold; };
@@ -546,31 +527,22 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     // 5. The ramps' scale assumed a string that does not roll. Every fit compared a rolling model
     //    in that scale (Engine::rampSoftening); a named torsion now says how much softer the ramps
     //    were, so the reported scale takes that factor (the final model's, at its own Z_t/Z_0).
-    //    A free ramp_softening (--free-ramp-scale) is that factor for a roll the model lacks.
-    //    Its interval carries ramp_softening's own.
     //    Without a named torsion, a roll no model named would read the ramps' scale 1/s too large,
     //    and a volt set cannot tell (seed 2061: 22 missed rolls of Z_t/Z_0 1.2-3 read it 0.6 to
     //    14.6 % high; with tension and bow position stated to +-1 % the interval then held the
     //    rig's scale on 11 of 29 sets). So the interval's low end leaves room for the rig
-    //    unknown's roll, as every finding's interval does, unless ramp_softening is free.
+    //    unknown's roll, as every finding's interval does.
     const double softer = engine.rampSoftening(d.final);
-    std::array<double, 2> softerRange{softer, softer};
-    bool softeningFree = false;
-    for (const auto& c : d.calibration)
-        if (c.name == "ramp_softening") {
-            softeningFree = true;
-            if (c.value > 0.0) softerRange = {softer * c.low / c.value, softer * c.high / c.value};
-        }
-    const bool rolled = softer < 1.0 || softerRange[0] < softer;
-    const bool roomForARoll = engine.scaleFromRamps() && !has(d.final.effects, "torsional_compliance") && !softeningFree;
+    const bool rolled = softer < 1.0;
+    const bool roomForARoll = engine.scaleFromRamps() && !has(d.final.effects, "torsional_compliance");
     if (rolled) d.scale *= softer;
     for (auto& c : d.calibration) {
         if (c.name != "scale_n_per_unit") continue;
         char note[128];
         if (rolled) {
             c.value *= softer;
-            c.low *= softerRange[0];
-            c.high *= softerRange[1];
+            c.low *= softer;
+            c.high *= softer;
             std::snprintf(note, sizeof note, "; times %.3f, the ramps' softening by a rolling string", softer);
             c.meaning += note;
         }

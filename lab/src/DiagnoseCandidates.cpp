@@ -37,10 +37,8 @@ Candidate withNuisances(Candidate c, const EffectModel& m)
     }
     const bool calibrated = m.params.count("tension_scale") > 0; // the diagnosis fits nuisances at all
     const bool thermal = has(m.effects, "thermal_memory") || has(c.adds, "thermal_memory");
-    const bool rolls = has(m.effects, "torsional_compliance") || has(c.adds, "torsional_compliance");
     for (const Nuisance& k : nuisances()) {
         if (!m.params.count(k.name) && !(k.thermalOnly && calibrated && thermal)) continue;
-        if (k.name == "ramp_softening" && rolls) continue; // held at 1 beside torsion: apply()
         c.names.push_back(k.name);
         c.lo.push_back(parameterBounds().at(k.name).first);
         c.hi.push_back(parameterBounds().at(k.name).second);
@@ -61,8 +59,7 @@ const std::vector<Nuisance>& nuisances()
         {"tension_scale", "true tension / manifest tension"},
         {"beta_scale", "true bow position / manifest beta"},
         {"rod_effusivity_scale",
-         "bow-side thermal effusivity / " + std::to_string(std::lround(dsp::ThermalParams{}.rodEffusivity)) + " W s^1/2 m^-2 K^-1", true},
-        {"ramp_softening", "true sensor scale / the scale the pre-slip ramps gave (a rolling string the model lacks softens them)"}};
+         "bow-side thermal effusivity / " + std::to_string(std::lround(dsp::ThermalParams{}.rodEffusivity)) + " W s^1/2 m^-2 K^-1", true}};
     return list;
 }
 
@@ -228,9 +225,7 @@ const std::map<std::string, std::pair<double, double>>& parameterBounds()
                                                                       {"shift_k", {-30.0, 30.0}},   {"zt_ratio", {0.7, 8.0}},
                                                                       {"tension_scale", {0.95, 1.05}}, {"beta_scale", {0.96, 1.04}},
                                                                       // bow hair and rosin: 300-600 W s^1/2 m^-2 K^-1 (W03 Table I gives 450)
-                                                                      {"rod_effusivity_scale", {0.65, 1.35}},
-                                                                      // down to the strongest roll the torsion search allows (Z_t/Z_0 = 0.7)
-                                                                      {"ramp_softening", {softeningAt(0.7), 1.0}}};
+                                                                      {"rod_effusivity_scale", {0.65, 1.35}}};
     return b;
 }
 
@@ -285,9 +280,6 @@ EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector
     for (const auto& e : c.adds)
         if (!has(m.effects, e)) m.effects.push_back(e);
     for (std::size_t k = 0; k < c.names.size(); ++k) m.params[c.names[k]] = x[k];
-    // ramp_softening is the softening of a roll the model lacks: a model with torsion makes its own
-    // (Engine::rampSoftening), so the two cannot trade and the reported scale takes it once.
-    if (has(m.effects, "torsional_compliance") && m.params.count("ramp_softening")) m.params["ramp_softening"] = 1.0;
     return m;
 }
 

@@ -182,16 +182,13 @@ double relativeRampSlope(double tensionScale, double betaScale)
 
 double Engine::rampSoftening(const EffectModel& m, const dsp::BowedStringConfig& c) const
 {
-    // ramp_softening (when the diagnosis leaves the scale free) is the softening of a roll the
-    // model lacks; a model with torsion holds it at 1 (apply()).
     // The ramps' scale made a rolling string's forces 1 / softening too large, so a rolling model
     // is compared in that scale, where it slips later at a higher force. Thermal models were once
     // exempt (torsion had stood in for a -17 K shift on a model-made set), which left a thermal
     // model with torsion at its true Z_t/Z_0 about 13 % short in every force and torsion beside
     // thermal memory unnamed (docs/diagnosis.md, step 2).
     if (!scaleFromRamps_) return 1.0;
-    const auto k = m.params.find("ramp_softening");
-    return rollingSoftening(c) * (k == m.params.end() ? 1.0 : k->second);
+    return rollingSoftening(c);
 }
 
 Engine::Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady,

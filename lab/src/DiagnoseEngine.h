@@ -305,8 +305,8 @@ public:
     /// The recordings' scale was read from their pre-slip ramps (a set in volts).
     bool scaleFromRamps() const { return scaleFromRamps_; }
     /// How much softer than a non-rolling string's model m's ramps are: its own roll's
-    /// rollingSoftening() times ramp_softening (a roll it lacks); 1 when the scale did not come
-    /// from the ramps. A voice's recorded gain is its inverse.
+    /// rollingSoftening(); 1 when the scale did not come from the ramps. A voice's recorded gain
+    /// is its inverse.
     double rampSoftening(const EffectModel& m, const dsp::BowedStringConfig& c) const;
     double rampSoftening(const EffectModel& m) const { return rampSoftening(m, config(m)); }
     /// Simulated features of stroke i under model m as the rig would record them: the

@@ -308,7 +308,6 @@ TEST(RosinCli, HelpExplainsTheCommandsAndGestures)
     };
     EXPECT_NE(helpOf("--pairs").find("(default: off)"), std::string::npos) << helpOf("--pairs");
     EXPECT_NE(helpOf("--contact-restart").find("(default: on)"), std::string::npos) << helpOf("--contact-restart");
-    EXPECT_NE(helpOf("--free-ramp-scale").find("(default: off)"), std::string::npos) << helpOf("--free-ramp-scale");
 }
 
 TEST(RosinCli, StringsListsEveryPreset)

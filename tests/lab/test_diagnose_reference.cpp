@@ -481,35 +481,32 @@ TEST(DiagnoseReferenceLong, ALaterRoundsContactSearchedAgainIsNamedAtItsExponent
     EXPECT_LT(hi, 1.0) << "the interval excludes Amontons";
 }
 
-// Seed 2059's set 6 (thermal memory, a rate law, a contact, a roll of Z_t/Z_0 2.2, in volts): the
-// roll's soft ramps read the sensor scale 7.8 % high and nothing is named. With the scale free
-// below the ramps' (--free-ramp-scale) the contact, thermal memory and the rate law are named at
-// their hidden values and the calibrated softening takes most of the scale's error out; the roll
-// itself stays unnamed (docs/diagnosis-study.md, thirtieth session). Two diagnoses: `long`.
-TEST(DiagnoseReferenceLong, AFreeRampScaleNamesWhatARollsInflatedScaleHid)
+// Seed 2059's set 6 (thermal memory, a rate law, a contact, a roll of Z_t/Z_0 2.2, in volts), its
+// tension and bow position stated to +-1 %: no roll is named and the roll's soft ramps read the
+// sensor scale 7.8 % high. The priors' share of the interval no longer reaches the rig's scale
+// (its low end 1.055 of it); the room for a roll no model named (x 0.912) is what holds it, and
+// the interval stays narrow. Unstated (+-5 % and +-4 %), the priors alone held it (low end 0.984).
+// One diagnosis of about a minute: `long`.
+TEST(DiagnoseReferenceLong, AMissedRollsInflatedScaleIsHeldByTheRoomLeftForIt)
 {
     SynthTruth truth;
-    const MeasurementSet set = studySet({"rate_dependence", "hertzian_contact", "torsional_compliance"}, 2059007, truth);
+    SynthSpec spec;
+    spec.generator = "reference";
+    spec.effects = {"rate_dependence", "hertzian_contact", "torsional_compliance"};
+    spec.seed = 2059007;
+    spec.grid = 12;
+    spec.statedUncertainty = {{"tension", 0.01}, {"beta", 0.01}};
+    const Diagnosis d = diagnose(throughFiles(spec, truth), DiagnoseOptions{});
     ASSERT_NEAR(truth.params.at("zt_ratio"), 2.20, 0.01);
-    const auto scaleError = [&](const Diagnosis& d) {
-        for (const auto& c : d.calibration)
-            if (c.name == "scale_n_per_unit") return c.value * truth.gain - 1.0;
-        return 1.0;
-    };
-    const Diagnosis fixed = diagnose(set, DiagnoseOptions{});
-    EXPECT_TRUE(fixed.findings.empty());
-    EXPECT_GT(scaleError(fixed), 0.06);
-    DiagnoseOptions free;
-    free.freeRampScale = true;
-    const Diagnosis d = diagnose(set, free);
-    const Finding* thermal = findingOf(d, "thermal_memory");
-    const Finding* rate = findingOf(d, "rate_dependence");
-    const Finding* contact = findingOf(d, "hertzian_contact");
-    ASSERT_TRUE(thermal && rate && contact);
-    EXPECT_NEAR(thermal->parameters.at("r_A")[0] / truth.params.at("r_A"), 1.0, 0.1);
-    EXPECT_NEAR(rate->parameters.at("p")[0], truth.params.at("p"), 0.1);
-    EXPECT_NEAR(contact->parameters.at("load_exponent")[0], truth.params.at("load_exponent"), 0.05);
-    EXPECT_LT(std::abs(scaleError(d)), 0.04);
+    ASSERT_EQ(findingOf(d, "torsional_compliance"), nullptr) << "the roll is named now: this test's premise is gone";
+    const auto scale = std::find_if(d.calibration.begin(), d.calibration.end(), [](const auto& c) { return c.name == "scale_n_per_unit"; });
+    ASSERT_NE(scale, d.calibration.end());
+    const double value = scale->value * truth.gain, low = scale->low * truth.gain, high = scale->high * truth.gain;
+    EXPECT_GT(value - 1.0, 0.06) << "the missed roll inflates the ramps' scale";
+    EXPECT_LE(low, 1.0) << "the room for an unnamed roll holds the rig's scale";
+    EXPECT_GE(high, 1.0);
+    EXPECT_GT(low / diag::softeningAt(diag::kReadilyRollingZt), 1.0) << "without the room the interval would miss it";
+    EXPECT_LT(high / low, 1.2) << "a measured rig's interval stays narrow";
     for (const auto& f : d.findings) EXPECT_NE(std::find(truth.effects.begin(), truth.effects.end(), f.effect), truth.effects.end()) << f.effect;
 }
 

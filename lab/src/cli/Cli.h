@@ -46,10 +46,6 @@ inline void addSearchFlags(CLI::App& cmd, DiagnoseOptions& o)
                  "A later round's Hertzian contact is searched again from where its first search ended, with a wider first step" +
                      byDefault(o.restartContact))
         ->capture_default_str();
-    cmd.add_flag("--free-ramp-scale,!--no-free-ramp-scale", o.freeRampScale,
-                 "In a set in volts, leave the sensor scale free below the one its pre-slip ramps give (a rolling string softens them) "
-                 "as a nuisance of every model" + byDefault(o.freeRampScale))
-        ->capture_default_str();
 }
 
 /// Choices shared by every command that builds a model.

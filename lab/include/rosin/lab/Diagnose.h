@@ -84,12 +84,6 @@ struct DiagnoseOptions {
     /// it carries r_A and the nuisances too, and its first search can stall where they stood
     /// (docs/diagnosis.md).
     bool restartContact = true;
-    /// A set in volts takes its sensor scale from the pre-slip ramps, assuming a string that does
-    /// not roll; a roll softens the ramps and inflates that scale, which nothing else in a
-    /// Guettler set pins. On: the true scale's share of the ramps' one (ramp_softening, from the
-    /// softening of the strongest roll the torsion search allows up to 1) is a nuisance of every
-    /// model, calibrated with tension and bow position (docs/diagnosis.md).
-    bool freeRampScale = false;
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     /// The model's own error on rigs it does not describe (their thermal constants, an unnamed
     /// torsion): the standard deviation that a finding's parameter still misses the truth by
