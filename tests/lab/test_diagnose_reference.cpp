@@ -47,7 +47,7 @@ MeasurementSet throughFiles(const SynthSpec& spec, SynthTruth& truth)
 /// A set as `rosin study` makes it (12x12 Guettler strokes from the reference simulator, the set's
 /// own seed: the study's seed times 1000 plus its index plus one), through files.
 MeasurementSet studySet(const std::vector<std::string>& effects, std::uint64_t seed, SynthTruth& truth,
-                        const std::map<std::string, double>& rig = {})
+                        const std::map<std::string, double>& rig = {}, const std::map<std::string, double>& statedUncertainty = {})
 {
     SynthSpec spec;
     spec.generator = "reference";
@@ -55,6 +55,7 @@ MeasurementSet studySet(const std::vector<std::string>& effects, std::uint64_t s
     spec.seed = seed;
     spec.grid = 12;
     spec.rig = rig;
+    spec.statedUncertainty = statedUncertainty;
     return throughFiles(spec, truth);
 }
 
@@ -490,13 +491,9 @@ TEST(DiagnoseReferenceLong, ALaterRoundsContactSearchedAgainIsNamedAtItsExponent
 TEST(DiagnoseReferenceLong, AMissedRollsInflatedScaleIsHeldByTheRoomLeftForIt)
 {
     SynthTruth truth;
-    SynthSpec spec;
-    spec.generator = "reference";
-    spec.effects = {"rate_dependence", "hertzian_contact", "torsional_compliance"};
-    spec.seed = 2059007;
-    spec.grid = 12;
-    spec.statedUncertainty = {{"tension", 0.01}, {"beta", 0.01}};
-    const Diagnosis d = diagnose(throughFiles(spec, truth), DiagnoseOptions{});
+    const Diagnosis d = diagnose(studySet({"rate_dependence", "hertzian_contact", "torsional_compliance"}, 2059007, truth, {},
+                                          {{"tension", 0.01}, {"beta", 0.01}}),
+                                 DiagnoseOptions{});
     ASSERT_NEAR(truth.params.at("zt_ratio"), 2.20, 0.01);
     ASSERT_EQ(findingOf(d, "torsional_compliance"), nullptr) << "the roll is named now: this test's premise is gone";
     const auto scale = std::find_if(d.calibration.begin(), d.calibration.end(), [](const auto& c) { return c.name == "scale_n_per_unit"; });
