@@ -222,6 +222,22 @@ std::string findingCaveats(const Finding& f)
                 "c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0). The ramps also trade s one for one with the rig's tension "
                 "over bow position, which the fits know only within their priors. ";
     }
+    // The shift is a length on the model's temperature axis, and the contact radius sets that
+    // axis: seed 2063's strong-shift study ran the same rigs with their drawn radius and at
+    // 300 um (docs/diagnosis-study.md). The rig table's Gauss-Newton move misses most of it,
+    // because r_A takes the radius up there.
+    if (f.parameters.count("shift_k")) {
+        const double modelRadiusUm = 1e6 * dsp::ThermalParams{}.contactRadiusAtRef;
+        const auto discrepancy = f.discrepancy.find("shift_k");
+        text += "The shift is in the model's kelvins, on its " + fmt(modelRadiusUm, "%.0f") +
+                " um contact: on the study's reference rigs the same shifts of 12-20 K read 1.1-1.8 times as large (median 1.4) on a "
+                "300 um contact and mostly under half, or not at all, on contacts under 200 um. So on a larger contact than the "
+                "model's the rosin's own shift is likely smaller than this value, on a smaller one larger; the contact-radius rows "
+                "of the rig table, which r_A mostly takes up, show less of this than it is";
+        if (discrepancy != f.discrepancy.end() && discrepancy->second > 0.0)
+            text += ", and the model discrepancy (+-" + fmt(discrepancy->second, "%.3g") + " K) is what carries it in the interval";
+        text += ". ";
+    }
     if (!text.empty()) text.pop_back();
     return text;
 }

@@ -897,7 +897,8 @@ TEST(DiagnoseConsistencyLong, RandomHiddenEffectsOverSeveralSeeds)
 
 // The reported interval counts the model discrepancy the studies measured. Where it reaches the
 // no-effect value the report says the data favour the effect without ruling out its absence; a
-// torsion's report gives the softening the data fix and the c_t/c its Z_t/Z_0 rests on.
+// torsion's report gives the softening the data fix and the c_t/c its Z_t/Z_0 rests on, and a
+// shift's the contact radius its kelvins rest on.
 TEST(DiagnoseParameters, TheReportSaysWhenTheModelDiscrepancyReachesNoEffect)
 {
     const auto npos = std::string::npos;
@@ -932,6 +933,19 @@ TEST(DiagnoseParameters, TheReportSaysWhenTheModelDiscrepancyReachesNoEffect)
     contact.parameters["load_exponent"] = {0.97, 0.95, 0.99}; // top 1.01
     EXPECT_FALSE(diag::clearOfNoEffect(contact, "load_exponent"));
     EXPECT_NE(diag::findingCaveats(contact).find("1 (Amontons)"), npos);
+
+    // A named shift says its kelvins rest on the model's contact radius, with the studies' numbers
+    Finding shift;
+    shift.effect = "rosin_temperature_shift";
+    shift.parameters["shift_k"] = {18.2, 17.2, 19.1};
+    shift.discrepancy["shift_k"] = 1.96 * 8.0;
+    const std::string shiftText = diag::findingCaveats(shift);
+    EXPECT_EQ(shiftText.find("no-effect"), npos) << shiftText;
+    EXPECT_NE(shiftText.find("on its 250 um contact"), npos) << shiftText;
+    EXPECT_NE(shiftText.find("(median 1.4) on a 300 um contact"), npos) << shiftText;
+    EXPECT_NE(shiftText.find("model discrepancy (+-15.7 K)"), npos) << shiftText;
+    shift.discrepancy.clear(); // --model-discrepancy shift_k=0: nothing to point at
+    EXPECT_EQ(diag::findingCaveats(shift).find("model discrepancy"), npos) << diag::findingCaveats(shift);
 
     Finding thermal; // r_A has no no-effect value: thermal memory is named by its fall, not its parameter
     thermal.effect = "thermal_memory";
