@@ -223,9 +223,9 @@ std::string findingCaveats(const Finding& f)
                 "over bow position, which the fits know only within their priors. ";
     }
     // The shift is a length on the model's temperature axis, and the contact radius sets that
-    // axis: seed 2063's strong-shift study ran the same rigs with their drawn radius and at
-    // 300 um (docs/diagnosis-study.md). The rig table's Gauss-Newton move misses most of it,
-    // because r_A takes the radius up there.
+    // axis: seed 2063's strong-shift study ran the same rigs as drawn, at 300 um and with the
+    // model's own thermal constants (docs/diagnosis-study.md). The rig table's Gauss-Newton move
+    // misses most of it, because r_A takes the radius up there.
     if (f.parameters.count("shift_k")) {
         const double modelRadiusUm = 1e6 * dsp::ThermalParams{}.contactRadiusAtRef;
         const auto discrepancy = f.discrepancy.find("shift_k");
