@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <random>
 
 #include "rosin/lab/Error.h"
@@ -207,10 +208,13 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     for (const auto& [key, value] : spec.rig) checkRigValue(key, value);
     for (const auto& [key, range] : spec.paramRanges) checkParamRange(key, range.first, range.second);
     for (const auto& [name, u] : spec.statedUncertainty) checkStatedUncertainty(name, u);
+    if (spec.generator != "reference" && spec.generator != "model-on-rig")
+        throw LabError("--generator " + spec.generator + " does not draw a reference rig");
+    const bool modelPhysics = spec.generator == "model-on-rig";
     std::mt19937_64 rng(spec.seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     truth = SynthTruth{};
-    truth.generator = "reference";
+    truth.generator = spec.generator;
     for (const auto& id : effectIds()) {
         const bool implied = id == "thermal_memory" && (has(spec.effects, "rosin_temperature_shift") || has(spec.effects, "rate_dependence"));
         if (has(spec.effects, id) || implied) truth.effects.push_back(id);
@@ -298,17 +302,54 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     rig["beta"] = beta;
     rig["z0_kg_per_s"] = z0;
     rig["sim_rate_hz"] = simRate;
-    reference::Simulator prototype = [&] {
+    // The string that makes the strokes: the reference simulator on the rig, or (model-on-rig)
+    // dsp/'s model, whose truth then records the values it really had where it holds its own.
+    std::optional<reference::Simulator> prototype;
+    std::optional<dsp::BowedStringConfig> model;
+    if (modelPhysics) {
+        model = modelOnRig(truth.effects, truth.params, rig, kManifestF0);
+        const dsp::ThermalParams& th = model->friction.thermal;
+        const dsp::StringParams& st = model->string;
+        for (auto [key, v] : {std::pair<const char*, double>{"inharmonicity", st.inharmonicity}, {"q_low", st.qLow}, {"q_high", st.qHigh},
+                              {"bridge_z0y", 0.0}, {"body_z0y", 0.0}, {"contact_radius_um", th.contactRadiusAtRef * 1e6},
+                              {"layer_um", th.layerThickness * 1e6}, {"rosin_heat", th.rosinHeatCapacity},
+                              {"string_effusivity", th.stringEffusivity}, {"torsion_speed_ratio", st.torsionSpeedRatio},
+                              {"q_torsion", st.qTorsion}, {"z0_kg_per_s", st.impedance()}})
+            rig[key] = v;
+    } else {
         try {
-            return reference::Simulator(r, beta, simRate);
+            prototype.emplace(r, beta, simRate);
         } catch (const std::invalid_argument& e) {
             throw LabError(std::string("synth-data: ") + e.what());
         }
-    }();
-    rig["cells"] = prototype.grid().cells;
+        rig["cells"] = prototype->grid().cells;
+    }
+    // Bridge force (and far-end force) of a gesture, {force, speed} = at(t), at the simulation rate.
+    auto play = [&](std::size_t length, const auto& at, std::vector<double>* far) {
+        std::vector<double> bridge(length);
+        if (far) far->assign(length, 0.0);
+        if (model) {
+            dsp::BowedString<double> s;
+            s.prepare(simRate, *model);
+            for (std::size_t i = 0; i < length; ++i) {
+                const auto [force, speed] = at(static_cast<double>(i) / simRate);
+                bridge[i] = s.processSample(force, speed, beta);
+                if (far) (*far)[i] = s.waveguide().farEndForce();
+            }
+            return bridge;
+        }
+        reference::Simulator sim = *prototype;
+        for (std::size_t i = 0; i < length; ++i) {
+            const auto [force, speed] = at(static_cast<double>(i) / simRate);
+            const reference::Sample x = sim.step(force, speed);
+            bridge[i] = x.bridgeForce;
+            if (far) (*far)[i] = x.farEndForce;
+        }
+        return bridge;
+    };
 
     MeasurementSet set;
-    set.description = "simulated by rosin synth-data --generator reference (seed " + std::to_string(spec.seed) + ")";
+    set.description = "simulated by rosin synth-data --generator " + spec.generator + " (seed " + std::to_string(spec.seed) + ")";
     set.stringName = "cello-D";
     set.f0 = kManifestF0;
     set.length = kManifestLength;
@@ -389,12 +430,10 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         made.force *= jitterForce;
         made.f0 *= jitterForce;
         const Gesture g = strokeGesture(made, beta);
-        reference::Simulator sim = prototype;
-        std::vector<double> bridge(static_cast<std::size_t>(spec.seconds * simRate));
-        for (std::size_t i = 0; i < bridge.size(); ++i) {
-            const auto c = g.at(static_cast<double>(i) / simRate);
-            bridge[i] = sim.step(c.force, c.speed).bridgeForce;
-        }
+        std::vector<double> bridge = play(static_cast<std::size_t>(spec.seconds * simRate), [&](double t) {
+            const auto c = g.at(t);
+            return std::pair{c.force, c.speed};
+        }, nullptr);
         const double trigger = spec.triggerMax * uu(sr);
         const auto pre = static_cast<std::size_t>(trigger * spec.outRate);
         m.signal = record(std::move(bridge), pre, sr);
@@ -416,14 +455,10 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         rec.id = "steady_" + std::to_string(k + 1);
         rec.bowSpeed = 0.05 + 0.05 * k;
         rec.force = 0.8;
-        reference::Simulator sim = prototype;
-        std::vector<double> b(static_cast<std::size_t>(0.4 * simRate)), far(b.size());
-        for (std::size_t i = 0; i < b.size(); ++i) {
-            const double t = static_cast<double>(i) / simRate;
-            const reference::Sample s = sim.step(rec.force, rec.bowSpeed * std::min(1.0, t / 0.03));
-            b[i] = s.bridgeForce;
-            far[i] = s.farEndForce;
-        }
+        std::vector<double> far;
+        std::vector<double> b = play(static_cast<std::size_t>(0.4 * simRate), [&](double t) {
+            return std::pair{rec.force, rec.bowSpeed * std::min(1.0, t / 0.03)};
+        }, &far);
         rec.bridge = record(std::move(b), 0, sr);
         rec.far = record(std::move(far), 0, sr);
     });

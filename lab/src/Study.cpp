@@ -1,5 +1,6 @@
 // `rosin study`, planning and running: which effects each set hides, and each set simulated by
-// the reference simulator and diagnosed from its files. Scoring is in StudyScore.cpp.
+// the reference simulator (or, as a ceiling, by dsp/'s model on the same rigs) and diagnosed
+// from its files. Scoring is in StudyScore.cpp.
 #include "rosin/lab/Study.h"
 
 #include <sndfile.h>
@@ -65,6 +66,8 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
 {
     const std::vector<StudySet> plan = planStudy(o);
     if (o.units != "V" && o.units != "N") throw LabError("study --units: '" + o.units + "' is neither V nor N");
+    if (o.generator != "reference" && o.generator != "model-on-rig")
+        throw LabError("study --generator: '" + o.generator + "' is neither reference nor model-on-rig");
     for (const int k : o.only)
         if (k < 0 || k >= static_cast<int>(plan.size()))
             throw LabError("study --only: set " + std::to_string(k) + " is not in a plan of " + std::to_string(plan.size()) + " sets");
@@ -75,6 +78,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     if (o.gesture != "guettler") planJson["gesture"] = o.gesture; // Guettler studies' plans stay as they were
     if (o.plan != 1) planJson["plan"] = o.plan;                    // and so do version-1 plans
     if (o.units == "N" && o.gesture != "exp_force") planJson["units"] = "N"; // and volt studies
+    if (o.generator != "reference") planJson["generator"] = o.generator;     // and reference ones
     if (!o.rig.empty()) planJson["rig"] = o.rig;                   // fixed rig values: part of the study
     for (const auto& [key, range] : o.paramRanges) planJson["param_ranges"][key] = {range.first, range.second}; // and narrowed draws
     if (!o.statedUncertainty.empty()) planJson["stated_uncertainty"] = o.statedUncertainty;      // and what the labs state
@@ -88,7 +92,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
         }
         if (before != planJson)
-            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture, units, fixed rig values, narrowed parameter ranges, stated uncertainties or plan version: "
+            throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture, units, generator, fixed rig values, narrowed parameter ranges, stated uncertainties or plan version: "
                                                           "a plan.json without \"plan\" is version 1, --plan 1); use a new folder");
     }
     fs::create_directories(dir / "sets");
@@ -121,7 +125,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             if (progress) progress("set " + std::string(name) + " (" + effectsLabel(p.effects) + "): " + what, (static_cast<double>(done - 1) + x) / static_cast<double>(picked.size()));
         };
         SynthSpec spec;
-        spec.generator = "reference";
+        spec.generator = o.generator;
         spec.seed = p.seed;
         spec.effects = p.effects;
         spec.grid = o.grid;

@@ -157,7 +157,7 @@ json readPlan(const fs::path& dir)
 json populationOf(const json& plan)
 {
     json p;
-    for (const char* key : {"grid", "gesture", "units", "rig", "param_ranges", "stated_uncertainty"})
+    for (const char* key : {"grid", "gesture", "units", "generator", "rig", "param_ranges", "stated_uncertainty"})
         if (plan.contains(key)) p[key] = plan[key];
     return p;
 }
@@ -246,7 +246,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         const json here = readPlan(study);
         if (populationOf(here) != populationOf(plan))
             throw LabError(study.string() + "/plan.json: " + populationOf(here).dump() + " where " + studies.front().string() + " has " +
-                           populationOf(plan).dump() + ": studies scored together must share the grid, gesture, units, fixed rig values, parameter ranges and stated uncertainties");
+                           populationOf(plan).dump() + ": studies scored together must share the grid, gesture, units, generator, fixed rig values, parameter ranges and stated uncertainties");
         const std::size_t before = sets.size();
         std::vector<fs::path> folders;
         for (const auto& e : fs::directory_iterator(study / "sets")) folders.push_back(e.path());
@@ -328,6 +328,12 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     if (standInSets > 0)
         md << "Possible stand-ins set aside beside a residual beyond the usual one (rule 6), not named: on " << standInSets << " of " << sets.size()
            << " sets; " << standInsNotHidden << " of them not hidden in their set (a wrong label kept out), " << standInsHidden << " hidden (a miss).\n";
+    if (plan.is_object() && plan.value("generator", "reference") == "model-on-rig") {
+        md << "Sets made by dsp/'s own model on the drawn rigs (`--generator model-on-rig`), not by the reference simulator: "
+              "what the diagnosis does when its model is the rig's physics and only its nuisances and the recording differ. "
+              "A ceiling and a consistency check, not a verdict on data the model did not make.\n";
+        summary["generator"] = "model-on-rig";
+    }
     if (plan.contains("rig")) {
         std::string fixed;
         for (const auto& [k, v] : plan["rig"].items()) fixed += (fixed.empty() ? "" : ", ") + k + fmt(" = %.3g", v.get<double>());

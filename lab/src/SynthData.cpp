@@ -59,11 +59,32 @@ dsp::BowedStringConfig modelWithEffects(const std::vector<std::string>& effects,
     return c;
 }
 
+dsp::BowedStringConfig modelOnRig(const std::vector<std::string>& effects, const std::map<std::string, double>& params,
+                                  const std::map<std::string, double>& rig, double f0)
+{
+    auto value = [&](const char* key) {
+        const auto it = rig.find(key);
+        if (it == rig.end()) throw LabError(std::string("model-on-rig: the rig has no ") + key);
+        return it->second;
+    };
+    dsp::BowedStringConfig c = modelWithEffects(effects, params);
+    // The rig's rosin, as its steady_sliding.csv measures it (the diagnosis fits the same shape).
+    const double level = value("mu_level");
+    c.friction.steadyCurve = dsp::SteadyCurve::exponentials(0.4 * level, 0.01 * value("mu_v1_scale"), 0.45 * level,
+                                                            0.1 * value("mu_v2_scale"), 0.35 * level * value("mu_floor_scale"));
+    // Tuned to the manifest's pitch: a tension off the maker's figure moves the mass with it, as
+    // the diagnosis's tension nuisance does.
+    c.string.tension = value("tension_n");
+    c.string.massPerLength = c.string.tension / std::pow(2.0 * c.string.length * f0, 2.0);
+    c.friction.thermal.rodEffusivity = value("rod_effusivity");
+    return c;
+}
+
 void writeTruth(const std::filesystem::path& file, const SynthTruth& truth, std::uint64_t seed)
 {
     nlohmann::json t{{"format", "rosin-synth-truth/1"}, {"generator", truth.generator}, {"effects", truth.effects},
                      {"params", truth.params}, {"gain_units_per_N", truth.gain}, {"seed", seed}, {"triggers_s", truth.triggers}};
-    if (truth.generator == "reference") {
+    if (truth.generator != "model") {
         t["rig"] = truth.rig;
         t["clipped_fraction"] = truth.clippedFraction;
         nlohmann::json strokes;
@@ -78,8 +99,8 @@ void writeTruth(const std::filesystem::path& file, const SynthTruth& truth, std:
 
 MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress)
 {
-    if (spec.generator == "reference") return synthesizeReference(spec, truth, progress);
-    if (spec.generator != "model") throw LabError("--generator must be model or reference");
+    if (spec.generator == "reference" || spec.generator == "model-on-rig") return synthesizeReference(spec, truth, progress);
+    if (spec.generator != "model") throw LabError("--generator must be model, reference or model-on-rig");
     if (!spec.rig.empty()) throw LabError("--rig-param applies to --generator reference only");
     if (!spec.statedUncertainty.empty()) throw LabError("--stated-uncertainty applies to --generator reference only");
     if (spec.gesture != "guettler") throw LabError("--gesture applies to --generator reference only");

@@ -143,6 +143,53 @@ TEST(ReferenceSynthData, ANewtonSetCarriesItsCalibrationErrorAndNothingElseMoves
     for (std::size_t k = 0; k < v.strokes.size(); ++k) EXPECT_EQ(v.strokes[k].signal, vFixed.strokes[k].signal);
 }
 
+// --generator model-on-rig: the reference generator's draws, played by dsp/'s model. What the model
+// holds fixed is recorded at the model's values, and the rig's tension and bow position reach the
+// strokes: a sticking bow's ramp is the bridge side's stiffness T / (beta L) times the bow's travel.
+TEST(ReferenceSynthData, AModelOnRigSetIsTheReferenceRigPlayedByTheModel)
+{
+    auto make = [](const std::string& generator, double tensionError, double betaError, SynthTruth& truth) {
+        SynthSpec spec = small(23);
+        spec.generator = generator;
+        spec.units = "N";
+        spec.seconds = 0.03;
+        spec.effects = {"torsional_compliance"};
+        spec.rig = {{"noise_n", 0.0}, {"hum_hz", 0.0}, {"dc_n", 0.0}, {"calibration_error", 0.0}, {"tension_error", tensionError},
+                    {"beta_error", betaError}};
+        return synthesize(spec, truth);
+    };
+    SynthTruth ref, soft, stiff;
+    const MeasurementSet r = make("reference", -0.03, 0.02, ref);
+    const MeasurementSet low = make("model-on-rig", -0.03, 0.02, soft), high = make("model-on-rig", 0.04, -0.025, stiff);
+    EXPECT_EQ(soft.generator, "model-on-rig");
+    EXPECT_EQ(soft.params, ref.params);
+    EXPECT_EQ(soft.triggers, ref.triggers);
+    for (const char* drawn : {"mu_level", "rod_effusivity", "sensor_hz", "tension_n", "beta"}) EXPECT_EQ(soft.rig.at(drawn), ref.rig.at(drawn)) << drawn;
+    // What the model holds is its own: the truth says what really made the strokes.
+    EXPECT_EQ(soft.rig.at("contact_radius_um"), 250.0);
+    EXPECT_EQ(soft.rig.at("torsion_speed_ratio"), 5.2);
+    EXPECT_EQ(soft.rig.at("bridge_z0y"), 0.0);
+    EXPECT_NE(ref.rig.at("contact_radius_um"), 250.0);
+    EXPECT_NE(r.strokes[0].signal, low.strokes[0].signal) << "another string made them";
+    EXPECT_NE(low.description.find("model-on-rig"), std::string::npos);
+    // The slowest, heaviest stroke (a00_f01) sticks through its first 10 ms after the trigger:
+    // mean force from 4 to 10 ms, the two rigs' ratio against their stiffness ratio.
+    auto ramp = [](const MeasurementSet& set, const SynthTruth& t) {
+        const auto& s = set.strokes[2];
+        const double start = t.triggers.at(s.id);
+        double sum = 0;
+        int n = 0;
+        for (std::size_t i = 0; i < s.signal.size(); ++i) {
+            const double time = static_cast<double>(i) / set.sampleRate - start;
+            if (time >= 0.004 && time < 0.010) sum += s.signal[i], ++n;
+        }
+        return sum / n;
+    };
+    ASSERT_EQ(low.strokes[2].id, "a00_f01");
+    const double expected = (1.04 / 0.975) / (0.97 / 1.02); // T / beta of the two rigs (same jittered gesture)
+    EXPECT_NEAR(ramp(high, stiff) / ramp(low, soft) / expected, 1.0, 0.005); // measured 1.00016
+}
+
 // --rig-param of synth-data and study: NAME=VALUE, each name one the generator draws and each
 // value a finite number; anything else is refused naming the value, before a set is simulated.
 TEST(ReferenceSynthData, RigValuesFromTheCommandLineAreParsedOrRefusedByName)

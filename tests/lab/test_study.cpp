@@ -359,6 +359,43 @@ TEST(Study, StatedUncertaintiesReachEverySetThePlanAndThePool)
     fs::remove_all(out);
 }
 
+// --generator model-on-rig: the same plan and rigs, made by dsp/'s model; the plan says so, a
+// reference study's folder refuses it, and a pool will not mix the two.
+TEST(Study, AModelOnRigStudyDrawsTheReferenceStudysRigsAndItsPlanSaysSo)
+{
+    const fs::path reference = freshDir("gen-ref"), model = freshDir("gen-model"), out = freshDir("gen-pool");
+    StudyOptions o;
+    o.sets = 2;
+    o.nulls = 0;
+    o.grid = 3;
+    o.seed = 19;
+    o.generateOnly = true;
+    runStudy(reference, o);
+    o.generator = "model-on-rig";
+    EXPECT_THROW(runStudy(reference, o), LabError) << "a reference study resumed with the model's sets";
+    runStudy(model, o);
+    json planR, planM;
+    std::ifstream(reference / "plan.json") >> planR;
+    std::ifstream(model / "plan.json") >> planM;
+    EXPECT_FALSE(planR.contains("generator")) << "reference plans stay as earlier studies wrote them";
+    EXPECT_EQ(planM["generator"], "model-on-rig");
+    EXPECT_EQ(planM["sets"], planR["sets"]) << "the same plan";
+    for (int k = 0; k < o.sets; ++k) {
+        json tr, tm;
+        std::ifstream(setDir(reference, k) / "truth.json") >> tr;
+        std::ifstream(setDir(model, k) / "truth.json") >> tm;
+        EXPECT_EQ(tm["generator"], "model-on-rig");
+        EXPECT_EQ(tm["params"], tr["params"]) << "set " << k;
+        for (const char* key : {"tension_error", "beta_error", "rod_effusivity", "mu_level", "noise_n", "dc_n", "hum_hz"})
+            EXPECT_EQ(tm["rig"][key], tr["rig"][key]) << key << ", set " << k;
+    }
+    const std::string refused = poolWithADrawnStudy(model, reference, out, 19);
+    EXPECT_NE(refused.find("generator"), std::string::npos) << refused;
+    o.generator = "finite-elements";
+    EXPECT_THROW(runStudy(freshDir("gen-bad"), o), LabError);
+    for (const auto& d : {reference, model, out, freshDir("gen-bad")}) fs::remove_all(d);
+}
+
 // --units N: every set is written in newtons through a sensor calibrated to within the rig's
 // calibration error; the plan says so, and a volt study's folder refuses it.
 TEST(Study, ANewtonStudyWritesItsSetsInNewtonsAndItsPlanSaysSo)

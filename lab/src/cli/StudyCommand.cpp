@@ -46,6 +46,11 @@ struct StudyCommand {
                         "Sensor units of every set: V (an unknown gain, set from the pre-slip ramps) or N (calibrated, within the rig's "
                         "calibration_error); exp_force sets are always N")
             ->check(CLI::IsMember({"V", "N"}))->capture_default_str();
+        cmd->add_option("--generator", options.generator,
+                        "What makes the sets: reference (the reference simulator, which shares no code with the model) or "
+                        "model-on-rig (the same plan and rigs, made by dsp/'s own model: the diagnosis's ceiling)")
+            ->check(CLI::IsMember({"reference", "model-on-rig"}))
+            ->capture_default_str();
         cmd->add_option("--oversampling", options.oversampling, "Reference simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         cmd->add_option("--diagnose-seed", options.diagnose.seed, "Seed of each diagnosis's split and bootstraps")->capture_default_str();
         cmd->add_option("--rig-param", rigValues,
@@ -66,7 +71,8 @@ struct StudyCommand {
         cmd->add_flag("--score-only", scoreOnly, "Only score what OUT already holds");
         cmd->add_option("--pool", pool,
                         "Score these finished studies (folders) together into OUT, as one study of all their sets; runs no set. They must "
-                        "share grid, gesture, units, fixed rig values, parameter ranges and stated uncertainties, and OUT must be none of them")
+                        "share grid, gesture, units, generator, fixed rig values, parameter ranges and stated uncertainties, and OUT must be "
+                        "none of them")
             ->check(CLI::ExistingDirectory)
             ->excludes("--only", "--hiding", "--generate-only", "--keep-sets", "--score-only");
         cmd->add_flag("-q,--quiet", options.quiet, "No progress and no summary");

@@ -47,8 +47,13 @@ struct SynthDataCommand {
                          "given, and written with the gain to OUT.truth.json beside the set, never inside it.\n"
                          "--generator model: dsp/'s own model makes the data (a consistency check).\n"
                          "--generator reference: the reference simulator (finite-difference stiff string, bridge\n"
-                         "resonances, exact-kernel heat) on a rig drawn from the seed; --rig-param fixes a value:\n" + rigKeys);
-        synthCmd->add_option("--generator", synth.generator, "model or reference")->check(CLI::IsMember({"model", "reference"}))->capture_default_str();
+                         "resonances, exact-kernel heat) on a rig drawn from the seed; --rig-param fixes a value:\n" + rigKeys +
+                         "--generator model-on-rig: the same draws as reference (effects, rig, sensor, hum, noise,\n"
+                         "gain), but dsp/'s model makes the strokes on the rig's tension, bow position, rosin curve\n"
+                         "and bow-side effusivity, everything else at the model's own values: the diagnosis's ceiling.\n");
+        synthCmd->add_option("--generator", synth.generator, "model, reference or model-on-rig")
+            ->check(CLI::IsMember({"model", "reference", "model-on-rig"}))
+            ->capture_default_str();
         synthCmd->add_option("--rig-param", rigParams, "Reference rig value NAME=VALUE instead of a drawn one (see below)");
         synthCmd->add_option("--stated-uncertainty", statedUncertainties,
                              "Reference: a lab that measured its rig, NAME=FRACTION (tension, beta): the rig's error is drawn within "

@@ -31,6 +31,10 @@ struct StudyOptions {
     /// The sensor's units (synth-data --units): V (an unknown gain, which the pre-slip ramps set)
     /// or N (calibrated, to within the rig's calibration_error). exp_force sets are always N.
     std::string units = "V";
+    /// What makes the sets: "reference" (the reference simulator, the studies' verdicts) or
+    /// "model-on-rig" (the same plan and draws, made by dsp/'s own model: what the diagnosis
+    /// could do if its model were the rig's physics, a ceiling and a consistency check).
+    std::string generator = "reference";
     /// Rig values fixed in every set instead of drawn (synth-data --rig-param): a study of rigs
     /// that differ from the model in a way no candidate names, such as a strongly stiff string.
     std::map<std::string, double> rig;

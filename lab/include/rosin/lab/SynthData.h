@@ -41,7 +41,10 @@ struct SynthSpec {
     int twoEnded = 2;                     ///< steady strokes recorded at both ends (0 = none)
     /// "model": dsp/'s own model makes the data (a consistency check of the diagnosis);
     /// "reference": the reference simulator (lab/reference, no code shared with dsp/) on a
-    /// rig drawn with every nuisance a lab never knows exactly (ReferenceData.h).
+    /// rig drawn with every nuisance a lab never knows exactly (ReferenceData.h);
+    /// "model-on-rig": the same draws as "reference" (effects, rig, sensor, noise), but dsp/'s
+    /// model makes the strokes (modelOnRig()): the diagnosis's ceiling, where nothing but the
+    /// nuisances it fits and the recording differ from its model.
     std::string generator = "model";
     std::map<std::string, double> rig;    ///< reference: rig values fixed instead of drawn (referenceRigKeys())
     /// reference: a hidden parameter drawn from this range instead of its whole prior (a study
@@ -80,5 +83,13 @@ MeasurementSet synthesize(const SynthSpec& spec, SynthTruth& truth, const std::f
 /// The model of DIAGNOSIS.md's baseline (friction curve, Amontons, no torsion, reference rosin)
 /// with the given effects switched on.
 dsp::BowedStringConfig modelWithEffects(const std::vector<std::string>& effects, const std::map<std::string, double>& params);
+
+/// The diagnosis's own model standing in for a drawn reference rig (`--generator model-on-rig`):
+/// the hidden effects at their values, on the rig's true string (its tension, tuned to the
+/// manifest's pitch f0), with the rig's steady-sliding curve and bow-side effusivity, the values
+/// the diagnosis fits or reads from the set; everything the model holds fixed (stiffness, losses,
+/// a rigid bridge, the contact's other thermal constants, the torsional wave speed) at its own.
+dsp::BowedStringConfig modelOnRig(const std::vector<std::string>& effects, const std::map<std::string, double>& params,
+                                  const std::map<std::string, double>& rig, double f0);
 
 } // namespace rosin::lab
