@@ -9,6 +9,7 @@
 #include <tuple>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -50,6 +51,34 @@ std::string poolWithADrawnStudy(const fs::path& study, const fs::path& whole, co
         return e.what();
     }
     return "pooled";
+}
+
+/// A 3x3 study of `sets` sets (`nulls` of them null) from `seed` that only makes its sets.
+StudyOptions madeOnly(int sets, int nulls, std::uint64_t seed)
+{
+    StudyOptions o;
+    o.sets = sets;
+    o.nulls = nulls;
+    o.grid = 3;
+    o.seed = seed;
+    o.generateOnly = true;
+    return o;
+}
+
+/// Runs study `o` into `first`; then, changed by `change`, checks that `first`'s folder refuses to
+/// resume as the changed study (`why` says what that would have mixed) and runs it into `second`.
+/// Returns both plans.
+std::pair<json, json> studiesBeforeAndAfter(const fs::path& first, const fs::path& second, StudyOptions& o,
+                                            const std::function<void(StudyOptions&)>& change, const char* why)
+{
+    runStudy(first, o);
+    change(o);
+    EXPECT_THROW(runStudy(first, o), LabError) << why;
+    runStudy(second, o);
+    json a, b;
+    std::ifstream(first / "plan.json") >> a;
+    std::ifstream(second / "plan.json") >> b;
+    return {a, b};
 }
 
 void writeSet(const fs::path& dir, int index, const json& truth, const json& diagnosis)
@@ -263,13 +292,8 @@ TEST(Study, RunsOnlyThePickedSetsOfTheWholePlan)
 TEST(Study, AFixedRigValueReachesEverySetAndThePlan)
 {
     const fs::path dir = freshDir("fixed-rig");
-    StudyOptions o;
-    o.sets = 2;
-    o.nulls = 1;
-    o.grid = 3;
-    o.seed = 12;
+    StudyOptions o = madeOnly(2, 1, 12);
     o.rig = {{"inharmonicity", 1e-3}};
-    o.generateOnly = true;
     runStudy(dir, o);
     json plan;
     std::ifstream(dir / "plan.json") >> plan;
@@ -291,14 +315,9 @@ TEST(Study, AFixedRigValueReachesEverySetAndThePlan)
 TEST(Study, ANarrowedParameterRangeReachesEverySetThePlanAndThePool)
 {
     const fs::path dir = freshDir("narrowed"), whole = freshDir("narrowed-whole"), out = freshDir("narrowed-pool");
-    StudyOptions o;
-    o.sets = 6;
-    o.nulls = 0;
-    o.grid = 3;
-    o.seed = 14;
+    StudyOptions o = madeOnly(6, 0, 14);
     o.hiding = "torsional_compliance";
     o.paramRanges = {{"zt_ratio", {1.2, 2.0}}};
-    o.generateOnly = true;
     runStudy(dir, o);
     json plan;
     std::ifstream(dir / "plan.json") >> plan;
@@ -330,13 +349,8 @@ TEST(Study, ANarrowedParameterRangeReachesEverySetThePlanAndThePool)
 TEST(Study, StatedUncertaintiesReachEverySetThePlanAndThePool)
 {
     const fs::path dir = freshDir("stated"), whole = freshDir("stated-whole"), out = freshDir("stated-pool");
-    StudyOptions o;
-    o.sets = 2;
-    o.nulls = 1;
-    o.grid = 3;
-    o.seed = 16;
+    StudyOptions o = madeOnly(2, 1, 16);
     o.statedUncertainty = {{"tension", 0.01}, {"beta", 0.01}};
-    o.generateOnly = true;
     runStudy(dir, o);
     json plan;
     std::ifstream(dir / "plan.json") >> plan;
@@ -364,19 +378,9 @@ TEST(Study, StatedUncertaintiesReachEverySetThePlanAndThePool)
 TEST(Study, AModelOnRigStudyDrawsTheReferenceStudysRigsAndItsPlanSaysSo)
 {
     const fs::path reference = freshDir("gen-ref"), model = freshDir("gen-model"), out = freshDir("gen-pool");
-    StudyOptions o;
-    o.sets = 2;
-    o.nulls = 0;
-    o.grid = 3;
-    o.seed = 19;
-    o.generateOnly = true;
-    runStudy(reference, o);
-    o.generator = "model-on-rig";
-    EXPECT_THROW(runStudy(reference, o), LabError) << "a reference study resumed with the model's sets";
-    runStudy(model, o);
-    json planR, planM;
-    std::ifstream(reference / "plan.json") >> planR;
-    std::ifstream(model / "plan.json") >> planM;
+    StudyOptions o = madeOnly(2, 0, 19);
+    const auto [planR, planM] = studiesBeforeAndAfter(reference, model, o, [](StudyOptions& x) { x.generator = "model-on-rig"; },
+                                                      "a reference study resumed with the model's sets");
     EXPECT_FALSE(planR.contains("generator")) << "reference plans stay as earlier studies wrote them";
     EXPECT_EQ(planM["generator"], "model-on-rig");
     EXPECT_EQ(planM["sets"], planR["sets"]) << "the same plan";
@@ -401,19 +405,8 @@ TEST(Study, AModelOnRigStudyDrawsTheReferenceStudysRigsAndItsPlanSaysSo)
 TEST(Study, ANewtonStudyWritesItsSetsInNewtonsAndItsPlanSaysSo)
 {
     const fs::path volts = freshDir("units-v"), newtons = freshDir("units-n");
-    StudyOptions o;
-    o.sets = 1;
-    o.nulls = 1;
-    o.grid = 3;
-    o.seed = 13;
-    o.generateOnly = true;
-    runStudy(volts, o);
-    o.units = "N";
-    EXPECT_THROW(runStudy(volts, o), LabError) << "a volt study resumed in newtons";
-    runStudy(newtons, o);
-    json planV, planN;
-    std::ifstream(volts / "plan.json") >> planV;
-    std::ifstream(newtons / "plan.json") >> planN;
+    StudyOptions o = madeOnly(1, 1, 13);
+    const auto [planV, planN] = studiesBeforeAndAfter(volts, newtons, o, [](StudyOptions& x) { x.units = "N"; }, "a volt study resumed in newtons");
     EXPECT_FALSE(planV.contains("units")) << "volt plans stay as earlier studies wrote them";
     EXPECT_EQ(planN["units"], "N");
     json tv, tn;
