@@ -46,6 +46,8 @@ std::map<std::string, std::pair<double, double>> parseParamRanges(const std::vec
 /// states U (rig.string.tension_uncertainty, rig.beta_uncertainty); a clear error otherwise.
 std::map<std::string, double> parseStatedUncertainties(const std::vector<std::string>& nameEqualsFraction);
 
+/// A set on a rig drawn from spec.seed. `--generator reference` plays it on the reference simulator;
+/// `model-on-rig` takes the very same draws and plays them on modelOnRig(), the diagnosis's ceiling.
 MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, const std::function<void(double)>& progress = {});
 
 } // namespace rosin::lab
