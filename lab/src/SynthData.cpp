@@ -68,10 +68,12 @@ dsp::BowedStringConfig modelOnRig(const std::vector<std::string>& effects, const
         return it->second;
     };
     dsp::BowedStringConfig c = modelWithEffects(effects, params);
-    // The rig's rosin, as its steady_sliding.csv measures it (the diagnosis fits the same shape).
+    // The rig's rosin, as its steady_sliding.csv measures it: the SW00 fit's shape (the curve's
+    // defaults) with the rig's level, speed scales and high-speed floor.
+    const dsp::SteadyCurve sw;
     const double level = value("mu_level");
-    c.friction.steadyCurve = dsp::SteadyCurve::exponentials(0.4 * level, 0.01 * value("mu_v1_scale"), 0.45 * level,
-                                                            0.1 * value("mu_v2_scale"), 0.35 * level * value("mu_floor_scale"));
+    c.friction.steadyCurve = dsp::SteadyCurve::exponentials(level * sw.a1, sw.v1 * value("mu_v1_scale"), level * sw.a2,
+                                                            sw.v2 * value("mu_v2_scale"), level * sw.a3 * value("mu_floor_scale"));
     // Tuned to the manifest's pitch: a tension off the maker's figure moves the mass with it, as
     // the diagnosis's tension nuisance does.
     c.string.tension = value("tension_n");
