@@ -1,6 +1,6 @@
 // `rosin study`, planning and running: which effects each set hides, and each set simulated by
 // the reference simulator (or, as a ceiling, by dsp/'s model on the same rigs) and diagnosed
-// from its files. Scoring is in StudyScore.cpp.
+// from its files; and the plan.json both halves read (StudyPlan.h). Scoring is in StudyScore.cpp.
 #include "rosin/lab/Study.h"
 
 #include <sndfile.h>
@@ -15,6 +15,7 @@
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
 #include "rosin/lab/SynthData.h"
+#include "StudyPlan.h"
 
 namespace rosin::lab {
 namespace fs = std::filesystem;
@@ -62,6 +63,27 @@ std::vector<StudySet> planStudy(const StudyOptions& o)
     return plan;
 }
 
+json readPlan(const fs::path& dir)
+{
+    json plan;
+    if (fs::exists(dir / "plan.json")) {
+        try {
+            std::ifstream(dir / "plan.json") >> plan;
+        } catch (const json::exception& e) {
+            throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
+        }
+    }
+    return plan;
+}
+
+json populationOf(const json& plan)
+{
+    json p;
+    for (const char* key : {"grid", "gesture", "units", "generator", "rig", "param_ranges", "stated_uncertainty"})
+        if (plan.contains(key)) p[key] = plan[key];
+    return p;
+}
+
 void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<void(const std::string&, double)>& progress)
 {
     const std::vector<StudySet> plan = planStudy(o);
@@ -85,13 +107,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     // A folder resumes only the study it holds: sets are skipped by folder name, so a different
     // seed, size or grid would silently mix two studies.
     if (fs::exists(dir / "plan.json")) {
-        json before;
-        try {
-            std::ifstream(dir / "plan.json") >> before;
-        } catch (const json::exception& e) {
-            throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
-        }
-        if (before != planJson)
+        if (readPlan(dir) != planJson)
             throw LabError((dir / "plan.json").string() + ": this folder holds a different study (seed, sets, nulls, grid, gesture, units, generator, fixed rig values, narrowed parameter ranges, stated uncertainties or plan version: "
                                                           "a plan.json without \"plan\" is version 1, --plan 1); use a new folder");
     }

@@ -5,11 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
 #include "DiagnoseEngine.h"
+#include "StudyPlan.h"
 #include "rosin/dsp/FrictionLaws.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Plot.h"
@@ -137,30 +139,14 @@ void drawFigure(const fs::path& file, const std::vector<Scored>& sets)
     canvas.save(file);
 }
 
-json readPlan(const fs::path& dir)
+/// A plan's object as "key<text>, key<text>", each text written from its value by `entry`.
+std::string joined(const json& items, const std::function<std::string(const json&)>& entry)
 {
-    json plan;
-    if (fs::exists(dir / "plan.json")) {
-        try {
-            std::ifstream(dir / "plan.json") >> plan;
-        } catch (const json::exception& e) {
-            throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
-        }
-    }
-    return plan;
+    std::string out;
+    for (const auto& [k, v] : items.items()) out += (out.empty() ? "" : ", ") + k + entry(v);
+    return out;
 }
 
-/// What must match for studies to be scored as one: the strokes, the rig population and the
-/// effects' size ranges (a study of narrowed sizes would skew a pooled detection rate). The seed,
-/// the number of sets and the plan version may differ (a plan of either version draws its sets
-/// from the same population of rigs and effects).
-json populationOf(const json& plan)
-{
-    json p;
-    for (const char* key : {"grid", "gesture", "units", "generator", "rig", "param_ranges", "stated_uncertainty"})
-        if (plan.contains(key)) p[key] = plan[key];
-    return p;
-}
 /// One set's truth and diagnosis, as the scoring needs them (`f` is DIR/sets/NNN).
 Scored readScored(const fs::path& f)
 {
@@ -335,24 +321,19 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         summary["generator"] = "model-on-rig";
     }
     if (plan.contains("rig")) {
-        std::string fixed;
-        for (const auto& [k, v] : plan["rig"].items()) fixed += (fixed.empty() ? "" : ", ") + k + fmt(" = %.3g", v.get<double>());
-        md << "Rig values fixed in every set instead of drawn: " << fixed << ".\n";
+        md << "Rig values fixed in every set instead of drawn: " << joined(plan["rig"], [](const json& v) { return fmt(" = %.3g", v.get<double>()); })
+           << ".\n";
         summary["fixed_rig"] = plan["rig"];
     }
     if (plan.contains("param_ranges")) {
-        std::string narrowed;
-        for (const auto& [k, v] : plan["param_ranges"].items())
-            narrowed += (narrowed.empty() ? "" : ", ") + k + fmt(" %.3g", v[0].get<double>()) + fmt(" to %.3g", v[1].get<double>());
-        md << "Hidden parameters drawn from narrowed ranges, not their whole priors: " << narrowed
+        md << "Hidden parameters drawn from narrowed ranges, not their whole priors: "
+           << joined(plan["param_ranges"], [](const json& v) { return fmt(" %.3g", v[0].get<double>()) + fmt(" to %.3g", v[1].get<double>()); })
            << ". Detection rates here describe those sizes only, not the study population.\n";
         summary["param_ranges"] = plan["param_ranges"];
     }
     if (plan.contains("stated_uncertainty")) {
-        std::string stated;
-        for (const auto& [k, v] : plan["stated_uncertainty"].items())
-            stated += (stated.empty() ? "" : ", ") + k + fmt(" +-%.3g %%", 100.0 * v.get<double>());
-        md << "Rigs of a lab that states what it measured: " << stated
+        md << "Rigs of a lab that states what it measured: "
+           << joined(plan["stated_uncertainty"], [](const json& v) { return fmt(" +-%.3g %%", 100.0 * v.get<double>()); })
            << " in every manifest, each rig's error drawn within it (the generator's own spread: tension +-4 %, bow position +-3 %).\n";
         summary["stated_uncertainty"] = plan["stated_uncertainty"];
     }

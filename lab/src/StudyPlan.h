@@ -1,0 +1,19 @@
+// A study's plan.json as the study's two halves share it (Study.cpp runs a plan, StudyScore.cpp
+// scores it): read from its folder, and the part of it that names the population its sets come
+// from. Internal to lab/.
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+namespace rosin::lab {
+
+/// DIR/plan.json, or null when the folder has none; an unreadable one is refused naming the file.
+nlohmann::json readPlan(const std::filesystem::path& dir);
+
+/// What must match for studies to be scored as one: the strokes, the rig population and the
+/// effects' size ranges (a study of narrowed sizes would skew a pooled detection rate). The seed,
+/// the number of sets and the plan version may differ (a plan of either version draws its sets
+/// from the same population of rigs and effects).
+nlohmann::json populationOf(const nlohmann::json& plan);
+
+} // namespace rosin::lab
