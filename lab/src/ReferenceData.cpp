@@ -210,7 +210,6 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     for (const auto& [name, u] : spec.statedUncertainty) checkStatedUncertainty(name, u);
     if (spec.generator != "reference" && spec.generator != "model-on-rig")
         throw LabError("--generator " + spec.generator + " does not draw a reference rig");
-    const bool modelPhysics = spec.generator == "model-on-rig";
     std::mt19937_64 rng(spec.seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     truth = SynthTruth{};
@@ -306,7 +305,7 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     // dsp/'s model, whose truth then records the values it really had where it holds its own.
     std::optional<reference::Simulator> prototype;
     std::optional<dsp::BowedStringConfig> model;
-    if (modelPhysics) {
+    if (spec.generator == "model-on-rig") {
         model = modelOnRig(truth.effects, truth.params, rig, kManifestF0);
         const dsp::ThermalParams& th = model->friction.thermal;
         const dsp::StringParams& st = model->string;
