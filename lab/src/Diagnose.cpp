@@ -130,6 +130,15 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         d.warnings.push_back(set.steady.empty() ? "no steady_sliding.csv: the reference SW00 curve is assumed for this rosin"
                                                 : "steady_sliding.csv has fewer than 5 rows: the reference SW00 curve is assumed");
     }
+    {
+        // Which string losses the model plays: a lab's measured Q, or the model's own.
+        const dsp::StringParams own{};
+        const bool stated = info.qAtF0 && info.qAt5kHz;
+        const double q0 = stated ? *info.qAtF0 : own.qLow, q5 = stated ? *info.qAt5kHz : own.qHigh;
+        const std::string whence = stated ? "as the manifest states it (rig.string.q_f0, q_5khz)" : "the model's own: the manifest does not state it";
+        d.calibration.push_back({"string_q_f0", "the string's transverse Q at f0, " + whence, q0, q0, q0});
+        d.calibration.push_back({"string_q_5khz", "the string's transverse Q at 5 kHz, " + whence, q5, q5, q5});
+    }
     Engine engine(strokes, info, o.simRate, steady, set.units == "V");
     EffectModel current;
     if (o.fitNuisances) {
@@ -147,7 +156,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         std::snprintf(text, sizeof text, "+-%.3g %%", 100.0 * (boundsOf(name, info).second - 1.0));
         return std::string(text) + (stated ? " (the manifest's stated prior)" : "");
     };
-    d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, tension within " + prior("tension_scale", info.tensionPrior) +
+    d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, the string's Q from the manifest where it states it (else the model's), tension within " + prior("tension_scale", info.tensionPrior) +
                    " and bow position within " + prior("beta_scale", info.betaPrior) +
                    " of the manifest, fitted on the fit strokes with the baseline model; effects are fitted on top of them. Once thermal memory "
                "is tried, the bow side's thermal effusivity (0.65-1.35 x 450) is a nuisance too.",

@@ -173,6 +173,8 @@ StringInfo stringInfoOf(const MeasurementSet& set)
     info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
     info.tensionPrior = set.tensionUncertainty;
     info.betaPrior = set.betaUncertainty;
+    info.qAtF0 = set.qAtF0;
+    info.qAt5kHz = set.qAt5kHz;
     return info;
 }
 

@@ -146,6 +146,13 @@ dsp::BowedStringConfig Engine::config(const EffectModel& m) const
     c.string.length = info_.length;
     c.string.tension = info_.tension * get("tension_scale");
     c.string.massPerLength = c.string.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
+    // A measured Q replaces the model's: the string's losses shape how a transient settles and
+    // trade with a roll's (docs/diagnosis-study.md), and no Guettler set can fit them itself.
+    if (info_.qAtF0 && info_.qAt5kHz) {
+        c.string.qLow = *info_.qAtF0;
+        c.string.qHigh = *info_.qAt5kHz;
+        c.string.qHighFrequency = 5000.0;
+    }
     c.friction.thermal.rodEffusivity *= get("rod_effusivity_scale");
     c.friction.thermal.contactRadiusAtRef *= get("contact_radius_scale");
     return c;

@@ -26,6 +26,8 @@ struct StringInfo {
     /// The manifest's stated priors of tension and bow position (a fraction either way); unset:
     /// parameterBounds()'s.
     std::optional<double> tensionPrior, betaPrior;
+    /// The string's Q at f0 and at 5 kHz as the manifest states them; unset: the model's own.
+    std::optional<double> qAtF0, qAt5kHz;
 };
 
 struct Prepared {

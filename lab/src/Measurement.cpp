@@ -207,6 +207,16 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
     };
     if (str.contains("tension_uncertainty")) set.tensionUncertainty = uncertainty(str, "tension_uncertainty", "rig.string.");
     if (rig.contains("beta_uncertainty")) set.betaUncertainty = uncertainty(rig, "beta_uncertainty", "rig.");
+    // A measured Q comes as a pair: the model's losses are set by both ends of its band.
+    if (str.contains("q_f0") || str.contains("q_5khz")) {
+        for (const char* key : {"q_f0", "q_5khz"}) {
+            if (!str.contains(key)) fail(manifest, std::string("rig.string.") + key, "is missing (q_f0 and q_5khz are stated together)");
+            const double q = positive(str, key, manifest, "rig.string.");
+            if (q < 5.0 || q > 1e5) fail(manifest, std::string("rig.string.") + key, "must be a Q from 5 to 100000");
+        }
+        set.qAtF0 = str["q_f0"].get<double>();
+        set.qAt5kHz = str["q_5khz"].get<double>();
+    }
     set.exciter = rig.value("exciter", "unknown");
     if (set.exciter != "bow" && set.exciter != "rod" && set.exciter != "unknown")
         fail(manifest, "rig.exciter", "must be \"bow\", \"rod\" or \"unknown\"");
@@ -353,6 +363,10 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
         if (set.tension) str["tension_n"] = *set.tension;
         if (set.z0) str["z0_kg_per_s"] = *set.z0;
         if (set.tensionUncertainty) str["tension_uncertainty"] = *set.tensionUncertainty;
+        if (set.qAtF0 && set.qAt5kHz) {
+            str["q_f0"] = *set.qAtF0;
+            str["q_5khz"] = *set.qAt5kHz;
+        }
         json rig{{"string", str}, {"beta", set.beta}, {"exciter", set.exciter},
                  {"sensor", {{"quantity", "bridge_force"}, {"units", set.units}, {"sample_rate_hz", set.sampleRate}}}};
         if (set.betaUncertainty) rig["beta_uncertainty"] = *set.betaUncertainty;

@@ -344,6 +344,15 @@ TEST(DiagnoseReference, RisingForceStrokesOfANullRigNameNothing)
     for (const auto& c : o.d.calibration)
         if (c.name == "dc_n") dc = c.value;
     EXPECT_NEAR(dc, o.truth.rig.at("dc_n"), 0.01);
+    // The manifest states no Q, so the report says the model played its own string losses.
+    int losses = 0;
+    for (const auto& c : o.d.calibration)
+        if (c.name == "string_q_f0" || c.name == "string_q_5khz") {
+            ++losses;
+            EXPECT_EQ(c.value, c.name == "string_q_f0" ? rosin::dsp::StringParams{}.qLow : rosin::dsp::StringParams{}.qHigh);
+            EXPECT_NE(c.meaning.find("the manifest does not state it"), std::string::npos) << c.meaning;
+        }
+    EXPECT_EQ(losses, 2);
     double peak = 0;
     for (const auto& f : o.d.measuredForce)
         for (double x : f) peak = std::max(peak, std::abs(x));

@@ -329,6 +329,45 @@ TEST(MeasurementSet, TheRigsStatedPriorsRoundTripAndAnAbsurdOneIsRefused)
     fs::remove_all(d);
 }
 
+// A lab that measured its string's Q (the decays of its partials) states it at the fundamental
+// and at 5 kHz: the pair survives a write and a read, and half a pair or a Q no string has is
+// refused naming the field.
+TEST(MeasurementSet, AMeasuredStringQRoundTripsAndHalfAPairOrAnAbsurdOneIsRefused)
+{
+    const fs::path d = freshDir("stringq");
+    MeasurementSet set = tinySet(6);
+    writeMeasurementSet(d / "none", set, SF_FORMAT_FLOAT);
+    EXPECT_FALSE(readMeasurementSet(d / "none").qAtF0.has_value());
+    set.qAtF0 = 420.0;
+    set.qAt5kHz = 130.0;
+    writeMeasurementSet(d / "stated", set, SF_FORMAT_FLOAT);
+    const MeasurementSet back = readMeasurementSet(d / "stated");
+    ASSERT_TRUE(back.qAtF0 && back.qAt5kHz);
+    EXPECT_EQ(*back.qAtF0, 420.0);
+    EXPECT_EQ(*back.qAt5kHz, 130.0);
+    // Half a pair: write both, then take one out of the manifest by hand.
+    writeMeasurementSet(d / "half", set, SF_FORMAT_FLOAT);
+    {
+        std::ifstream in(d / "half" / "manifest.json");
+        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const auto at = text.find("\"q_5khz\"");
+        ASSERT_NE(at, std::string::npos);
+        text.replace(at, 8, "\"q_5k\"");
+        std::ofstream(d / "half" / "manifest.json") << text;
+    }
+    std::string e = errorOf(d / "half");
+    EXPECT_NE(e.find("field 'rig.string.q_5khz' is missing"), std::string::npos) << e;
+    set.qAtF0 = 2.0; // a string that rings for less than a period
+    writeMeasurementSet(d / "absurd", set, SF_FORMAT_FLOAT);
+    e = errorOf(d / "absurd");
+    EXPECT_NE(e.find("field 'rig.string.q_f0' must be a Q from 5 to 100000"), std::string::npos) << e;
+    set.qAtF0 = -400.0;
+    writeMeasurementSet(d / "negative", set, SF_FORMAT_FLOAT);
+    e = errorOf(d / "negative");
+    EXPECT_NE(e.find("rig.string.q_f0"), std::string::npos) << e;
+    fs::remove_all(d);
+}
+
 // A set may mix gestures (gesture.kind "mixed"): each transient names its own kind and that
 // kind's fields; they survive a write and a read, and a transient that names none is refused.
 TEST(MeasurementSet, MixedGesturesRoundTripAndAStrokeWithoutItsKindIsRefused)

@@ -50,6 +50,9 @@ struct MeasurementSet {
     /// fraction of the stated one (rig.string.tension_uncertainty, rig.beta_uncertainty). Unset:
     /// the diagnosis's own priors (+-5 %, +-4 %).
     std::optional<double> tensionUncertainty, betaUncertainty;
+    /// The string's transverse Q as the lab measured it (rig.string.q_f0, rig.string.q_5khz: from
+    /// the decays of its partials at the fundamental and near 5 kHz). Unset: the model's own.
+    std::optional<double> qAtF0, qAt5kHz;
     std::string exciter = "unknown";   ///< bow, rod or unknown
     std::optional<double> ambient;     ///< C
     std::string units = "N";           ///< N (calibrated) or V (scale unknown)
