@@ -173,12 +173,20 @@ const RigPrior& statedError(const std::string& name)
     const auto& pr = referenceRigPriors();
     const auto it = std::find_if(pr.begin(), pr.end(), [&](const RigPrior& r) { return r.key == key; });
     if ((name != "tension" && name != "beta") || it == pr.end())
-        throw LabError("--stated-uncertainty: unknown rig value '" + name + "' (tension, beta)");
+        throw LabError("--stated-uncertainty: unknown rig value '" + name + "' (tension, beta, q)");
     return *it;
 }
 
+/// How far a lab's measured Q may stand off the string's (a decay fit's error).
+constexpr double kQMeasurementSpreadMax = 0.3;
+
 void checkStatedUncertainty(const std::string& name, double u)
 {
+    if (name == "q") {
+        if (!std::isfinite(u) || u < 0.001 || u > kQMeasurementSpreadMax)
+            throw LabError("--stated-uncertainty: q must be a fraction from 0.001 to 0.3 (how far the stated Q stands off the string's)");
+        return;
+    }
     const double spread = statedError(name).hi;
     if (!std::isfinite(u) || u < 0.001 || u > spread) {
         char range[96];
@@ -362,6 +370,16 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     set.gesture = spec.gesture;
     if (const auto t = spec.statedUncertainty.find("tension"); t != spec.statedUncertainty.end()) set.tensionUncertainty = t->second;
     if (const auto b = spec.statedUncertainty.find("beta"); b != spec.statedUncertainty.end()) set.betaUncertainty = b->second;
+    // A lab that measured its string's Q (a pluck's decays) to +-U states it; the error is drawn
+    // from a stream of its own, so the rig and every other draw stay those of the unmeasured rig.
+    if (const auto q = spec.statedUncertainty.find("q"); q != spec.statedUncertainty.end()) {
+        std::mt19937_64 qr(spec.seed * 2862933555777941757ull + 3037000493ull);
+        const double e0 = q->second * (2.0 * u(qr) - 1.0), e5 = q->second * (2.0 * u(qr) - 1.0);
+        set.qAtF0 = rig["q_low"] * (1.0 + e0);
+        set.qAt5kHz = rig["q_high"] * (1.0 + e5);
+        rig["q_f0_stated"] = *set.qAtF0;
+        rig["q_5khz_stated"] = *set.qAt5kHz;
+    }
     // The lab's own steady-sliding measurement of this rosin, 1 % scatter.
     {
         std::normal_distribution<double> g(0.0, 1.0);

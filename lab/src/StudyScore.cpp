@@ -334,7 +334,8 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     if (plan.contains("stated_uncertainty")) {
         md << "Rigs of a lab that states what it measured: "
            << joined(plan["stated_uncertainty"], [](const json& v) { return fmt(" +-%.3g %%", 100.0 * v.get<double>()); })
-           << " in every manifest, each rig's error drawn within it (the generator's own spread: tension +-4 %, bow position +-3 %).\n";
+           << " in every manifest, each rig's error drawn within it (the generator's own spread: tension +-4 %, bow position +-3 %; "
+              "q: the string's Q at f0 and 5 kHz stated within that of the rig's).\n";
         summary["stated_uncertainty"] = plan["stated_uncertainty"];
     }
     md << "\n";

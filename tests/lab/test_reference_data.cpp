@@ -9,6 +9,7 @@
 #include <fstream>
 #include <optional>
 
+#include "rosin/dsp/StringParams.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
 #include "rosin/lab/ReferenceData.h"
@@ -257,7 +258,10 @@ TEST(ReferenceSynthData, StatedUncertaintiesAreParsedOrRefusedByName)
     EXPECT_EQ(stated.at("tension"), 0.01);
     EXPECT_EQ(stated.at("beta"), 0.005);
     const auto refusal = [](const std::vector<std::string>& args) { return refusalOf(parseStatedUncertainties, args); };
-    EXPECT_NE(refusal({"length=0.01"}).find("unknown rig value 'length' (tension, beta)"), std::string::npos);
+    EXPECT_NE(refusal({"length=0.01"}).find("unknown rig value 'length' (tension, beta, q)"), std::string::npos);
+    EXPECT_EQ(parseStatedUncertainties({"q=0.1"}).at("q"), 0.1);
+    EXPECT_NE(refusal({"q=0.5"}).find("q must be a fraction from 0.001 to 0.3"), std::string::npos);
+    EXPECT_NE(refusal({"q=0"}).find("q must be a fraction"), std::string::npos);
     EXPECT_NE(refusal({"tension_error=0.01"}).find("unknown rig value"), std::string::npos);
     EXPECT_NE(refusal({"tension"}).find("expected NAME=FRACTION"), std::string::npos);
     EXPECT_NE(refusal({"tension=1%"}).find("has no number"), std::string::npos);
@@ -302,6 +306,42 @@ TEST(ReferenceSynthData, AStatedUncertaintyBoundsTheRigsErrorAndTheManifestSaysI
     EXPECT_DOUBLE_EQ(*back.tension, 102.6) << "the manifest keeps the nominal tension";
     spec.generator = "model";
     EXPECT_THROW(synthesize(spec, measured), LabError) << "the model generator has no rig to measure";
+}
+
+// A lab that measured its string's Q to +-10 %: the manifest states Q at f0 and at 5 kHz within
+// that of the rig's own (each end its own error), and the rig, the hidden parameters and every
+// recording are those of the same rig unmeasured. The model-on-rig generator states the Q its
+// string had (the model's own).
+TEST(ReferenceSynthData, AStatedQIsTheRigsWithinItsFractionAndMovesNothingElse)
+{
+    SynthSpec spec = small(34);
+    spec.effects = {"torsional_compliance"};
+    SynthTruth unmeasured, measured;
+    const MeasurementSet plain = synthesize(spec, unmeasured);
+    EXPECT_FALSE(plain.qAtF0.has_value());
+    spec.statedUncertainty = {{"q", 0.1}};
+    const MeasurementSet set = synthesize(spec, measured);
+    ASSERT_TRUE(set.qAtF0 && set.qAt5kHz);
+    const double e0 = *set.qAtF0 / unmeasured.rig.at("q_low") - 1.0, e5 = *set.qAt5kHz / unmeasured.rig.at("q_high") - 1.0;
+    EXPECT_LE(std::abs(e0), 0.1);
+    EXPECT_LE(std::abs(e5), 0.1);
+    EXPECT_NE(e0, e5) << "one error drawn for both ends";
+    EXPECT_EQ(measured.rig.at("q_f0_stated"), *set.qAtF0);
+    for (const auto& [key, value] : unmeasured.rig) EXPECT_EQ(measured.rig.at(key), value) << key << " moved";
+    EXPECT_EQ(measured.params, unmeasured.params);
+    ASSERT_EQ(set.strokes.size(), plain.strokes.size());
+    for (std::size_t i = 0; i < set.strokes.size(); ++i) EXPECT_EQ(set.strokes[i].signal, plain.strokes[i].signal) << "stroke " << i;
+    // Another seed draws other errors.
+    SynthSpec other = spec;
+    other.seed = 35;
+    SynthTruth otherTruth;
+    const MeasurementSet otherSet = synthesize(other, otherTruth);
+    EXPECT_NE(*otherSet.qAtF0 / otherTruth.rig.at("q_low") - 1.0, e0);
+    spec.generator = "model-on-rig";
+    SynthTruth modelTruth;
+    const MeasurementSet modelSet = synthesize(spec, modelTruth);
+    EXPECT_LE(std::abs(*modelSet.qAtF0 / rosin::dsp::StringParams{}.qLow - 1.0), 0.1);
+    EXPECT_LE(std::abs(*modelSet.qAt5kHz / rosin::dsp::StringParams{}.qHigh - 1.0), 0.1);
 }
 
 // The one reading of "is this text a number" behind every command-line value and data field.

@@ -57,7 +57,8 @@ struct SynthDataCommand {
         synthCmd->add_option("--rig-param", rigParams, "Reference rig value NAME=VALUE instead of a drawn one (see below)");
         synthCmd->add_option("--stated-uncertainty", statedUncertainties,
                              "Reference: a lab that measured its rig, NAME=FRACTION (tension, beta): the rig's error is drawn within "
-                             "+-FRACTION and the manifest states it");
+                             "+-FRACTION and the manifest states it; q: the manifest states the string's Q at f0 and 5 kHz within "
+                             "+-FRACTION of the rig's");
         synthCmd->add_option("--oversampling", synth.oversampling, "Reference: simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         synthCmd->add_option("--gesture", synth.gesture, "Reference: guettler, exp_speed (v0/tv x F), exp_force (speed x F0) or mixed")
             ->check(CLI::IsMember({"guettler", "exp_speed", "exp_force", "mixed"}))->capture_default_str();
