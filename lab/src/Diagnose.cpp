@@ -130,17 +130,15 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         d.warnings.push_back(set.steady.empty() ? "no steady_sliding.csv: the reference SW00 curve is assumed for this rosin"
                                                 : "steady_sliding.csv has fewer than 5 rows: the reference SW00 curve is assumed");
     }
-    {
-        // Which string losses the model plays: a lab's measured Q, or the model's own.
-        const dsp::StringParams own{};
-        const bool stated = info.qAtF0 && info.qAt5kHz;
-        const double q0 = stated ? *info.qAtF0 : own.qLow, q5 = stated ? *info.qAt5kHz : own.qHigh;
-        const std::string whence = stated ? "as the manifest states it (rig.string.q_f0, q_5khz)" : "the model's own: the manifest does not state it";
-        d.calibration.push_back({"string_q_f0", "the string's transverse Q at f0, " + whence, q0, q0, q0});
-        d.calibration.push_back({"string_q_5khz", "the string's transverse Q at 5 kHz, " + whence, q5, q5, q5});
-    }
     Engine engine(strokes, info, o.simRate, steady, set.units == "V");
     EffectModel current;
+    {
+        // Which string losses the model plays (Engine::config decides): a lab's measured Q, or the model's own.
+        const dsp::StringParams played = engine.config(current).string;
+        const std::string whence = info.qAtF0 && info.qAt5kHz ? "as the manifest states it (rig.string.q_f0, q_5khz)" : "the model's own: the manifest does not state it";
+        d.calibration.push_back({"string_q_f0", "the string's transverse Q at f0, " + whence, played.qLow, played.qLow, played.qLow});
+        d.calibration.push_back({"string_q_5khz", "the string's transverse Q at 5 kHz, " + whence, played.qHigh, played.qHigh, played.qHigh});
+    }
     if (o.fitNuisances) {
         say("calibration: tension and bow position", 0.0);
         Candidate cal = candidate("calibration", {"tension_scale", "beta_scale"}, {1.0, 1.0});

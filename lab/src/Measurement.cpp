@@ -209,13 +209,14 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
     if (rig.contains("beta_uncertainty")) set.betaUncertainty = uncertainty(rig, "beta_uncertainty", "rig.");
     // A measured Q comes as a pair: the model's losses are set by both ends of its band.
     if (str.contains("q_f0") || str.contains("q_5khz")) {
-        for (const char* key : {"q_f0", "q_5khz"}) {
+        const auto measuredQ = [&](const char* key) {
             if (!str.contains(key)) fail(manifest, std::string("rig.string.") + key, "is missing (q_f0 and q_5khz are stated together)");
             const double q = positive(str, key, manifest, "rig.string.");
             if (q < 5.0 || q > 1e5) fail(manifest, std::string("rig.string.") + key, "must be a Q from 5 to 100000");
-        }
-        set.qAtF0 = str["q_f0"].get<double>();
-        set.qAt5kHz = str["q_5khz"].get<double>();
+            return q;
+        };
+        set.qAtF0 = measuredQ("q_f0");
+        set.qAt5kHz = measuredQ("q_5khz");
     }
     set.exciter = rig.value("exciter", "unknown");
     if (set.exciter != "bow" && set.exciter != "rod" && set.exciter != "unknown")

@@ -182,16 +182,15 @@ constexpr double kQMeasurementSpreadMax = 0.3;
 
 void checkStatedUncertainty(const std::string& name, double u)
 {
-    if (name == "q") {
-        if (!std::isfinite(u) || u < 0.001 || u > kQMeasurementSpreadMax)
-            throw LabError("--stated-uncertainty: q must be a fraction from 0.001 to 0.3 (how far the stated Q stands off the string's)");
-        return;
-    }
-    const double spread = statedError(name).hi;
-    if (!std::isfinite(u) || u < 0.001 || u > spread) {
-        char range[96];
-        std::snprintf(range, sizeof range, "a fraction from 0.001 to %g (the generator's own spread of its error)", spread);
-        throw LabError("--stated-uncertainty: " + name + " must be " + range);
+    // Tension and beta bound the rig's own error, so no wider than the generator draws it; q
+    // bounds how far the manifest's Q stands off the rig's.
+    const bool q = name == "q";
+    const double widest = q ? kQMeasurementSpreadMax : statedError(name).hi;
+    if (!std::isfinite(u) || u < 0.001 || u > widest) {
+        char range[48];
+        std::snprintf(range, sizeof range, "a fraction from 0.001 to %g", widest);
+        throw LabError("--stated-uncertainty: " + name + " must be " + range +
+                       (q ? " (how far the stated Q stands off the string's)" : " (the generator's own spread of its error)"));
     }
 }
 } // namespace

@@ -64,6 +64,16 @@ std::string fileBytes(const fs::path& f)
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+/// Replaces the first `from` in the set's manifest.json by `to` (a hand edit a writer would not make).
+void editManifest(const fs::path& folder, const std::string& from, const std::string& to)
+{
+    std::string text = fileBytes(folder / "manifest.json");
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    std::ofstream(folder / "manifest.json") << text;
+}
+
 /// The ids of a RIFF file's top-level chunks, in order.
 std::vector<std::string> riffChunks(const fs::path& wav)
 {
@@ -226,14 +236,6 @@ TEST(MeasurementSet, BrokenSetsAreRefusedNamingFileAndField)
         writeMeasurementSet(f, set, SF_FORMAT_FLOAT);
         return f;
     };
-    auto editManifest = [](const fs::path& f, const std::string& from, const std::string& to) {
-        std::ifstream in(f / "manifest.json");
-        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        const auto at = text.find(from);
-        ASSERT_NE(at, std::string::npos) << from;
-        text.replace(at, from.size(), to);
-        std::ofstream(f / "manifest.json") << text;
-    };
     EXPECT_NE(errorOf(d / "nothing-here").find("no such measurement set"), std::string::npos);
     {
         const fs::path f = fresh("format");
@@ -347,14 +349,7 @@ TEST(MeasurementSet, AMeasuredStringQRoundTripsAndHalfAPairOrAnAbsurdOneIsRefuse
     EXPECT_EQ(*back.qAt5kHz, 130.0);
     // Half a pair: write both, then take one out of the manifest by hand.
     writeMeasurementSet(d / "half", set, SF_FORMAT_FLOAT);
-    {
-        std::ifstream in(d / "half" / "manifest.json");
-        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        const auto at = text.find("\"q_5khz\"");
-        ASSERT_NE(at, std::string::npos);
-        text.replace(at, 8, "\"q_5k\"");
-        std::ofstream(d / "half" / "manifest.json") << text;
-    }
+    editManifest(d / "half", "\"q_5khz\"", "\"q_5k\"");
     std::string e = errorOf(d / "half");
     EXPECT_NE(e.find("field 'rig.string.q_5khz' is missing"), std::string::npos) << e;
     set.qAtF0 = 2.0; // a string that rings for less than a period
