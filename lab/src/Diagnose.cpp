@@ -138,6 +138,14 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         const std::string whence = info.qAtF0 && info.qAt5kHz ? "as the manifest states it (rig.string.q_f0, q_5khz)" : "the model's own: the manifest does not state it";
         d.calibration.push_back({"string_q_f0", "the string's transverse Q at f0, " + whence, played.qLow, played.qLow, played.qLow});
         d.calibration.push_back({"string_q_5khz", "the string's transverse Q at 5 kHz, " + whence, played.qHigh, played.qHigh, played.qHigh});
+        if (info.torsionSpeedRatio && info.qTorsion) d.statedTorsionSpeedRatio = played.torsionSpeedRatio;
+        const std::string torsional = info.torsionSpeedRatio && info.qTorsion
+                                          ? "as the manifest states it (rig.string.torsion_speed_ratio, q_torsion)"
+                                          : "the model's own: the manifest does not state it";
+        d.calibration.push_back({"torsion_speed_ratio", "the string's torsional wave speed over its transverse one, played where a roll is tried, " + torsional,
+                                 played.torsionSpeedRatio, played.torsionSpeedRatio, played.torsionSpeedRatio});
+        d.calibration.push_back({"torsion_q", "the string's torsional Q, played where a roll is tried, " + torsional, played.qTorsion,
+                                 played.qTorsion, played.qTorsion});
     }
     if (o.fitNuisances) {
         say("calibration: tension and bow position", 0.0);
@@ -154,7 +162,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         std::snprintf(text, sizeof text, "+-%.3g %%", 100.0 * (boundsOf(name, info).second - 1.0));
         return std::string(text) + (stated ? " (the manifest's stated prior)" : "");
     };
-    d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, the string's Q from the manifest where it states it (else the model's), tension within " + prior("tension_scale", info.tensionPrior) +
+    d.rules = {"Calibration first: the steady-sliding curve from steady_sliding.csv, the string's transverse Q and its torsional c_t / c and Q_t from the manifest where it states them (else the model's), tension within " + prior("tension_scale", info.tensionPrior) +
                    " and bow position within " + prior("beta_scale", info.betaPrior) +
                    " of the manifest, fitted on the fit strokes with the baseline model; effects are fitted on top of them. Once thermal memory "
                "is tried, the bow side's thermal effusivity (0.65-1.35 x 450) is a nuisance too.",
@@ -554,7 +562,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             c.meaning += note;
         }
         if (roomForARoll) {
-            const double s = softeningAt(kReadilyRollingZt);
+            const double s = softeningAt(kReadilyRollingZt, d.statedTorsionSpeedRatio);
             c.low *= s;
             std::snprintf(note, sizeof note, "; its low end times %.3f, the softening of a roll of Z_t/Z_0 = %g that no model named", s, kReadilyRollingZt);
             c.meaning += note;

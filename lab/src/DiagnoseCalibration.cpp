@@ -175,6 +175,8 @@ StringInfo stringInfoOf(const MeasurementSet& set)
     info.betaPrior = set.betaUncertainty;
     info.qAtF0 = set.qAtF0;
     info.qAt5kHz = set.qAt5kHz;
+    info.torsionSpeedRatio = set.torsionSpeedRatio;
+    info.qTorsion = set.qTorsion;
     return info;
 }
 

@@ -153,6 +153,12 @@ dsp::BowedStringConfig Engine::config(const EffectModel& m) const
         c.string.qHigh = *info_.qAt5kHz;
         c.string.qHighFrequency = 5000.0;
     }
+    // So do measured torsional constants: a roll's softening is 1 / (1 + Z_0 c / (Z_t c_t)), so
+    // a c_t off the string's moves the Z_t/Z_0 a roll is read at (docs/diagnosis-study.md).
+    if (info_.torsionSpeedRatio && info_.qTorsion) {
+        c.string.torsionSpeedRatio = *info_.torsionSpeedRatio;
+        c.string.qTorsion = *info_.qTorsion;
+    }
     c.friction.thermal.rodEffusivity *= get("rod_effusivity_scale");
     c.friction.thermal.contactRadiusAtRef *= get("contact_radius_scale");
     return c;

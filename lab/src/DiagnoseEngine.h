@@ -28,6 +28,8 @@ struct StringInfo {
     std::optional<double> tensionPrior, betaPrior;
     /// The string's Q at f0 and at 5 kHz as the manifest states them; unset: the model's own.
     std::optional<double> qAtF0, qAt5kHz;
+    /// The string's c_t / c and torsional Q as the manifest states them; unset: the model's own.
+    std::optional<double> torsionSpeedRatio, qTorsion;
 };
 
 struct Prepared {
@@ -90,17 +92,18 @@ std::string noEffectValue(const std::string& name);
 bool clearOfNoEffect(const Finding& f, const std::string& name);
 /// The c_t / c the lab's models take for a rolling string (the data do not fix it).
 double assumedTorsionSpeedRatio();
-/// A rolling string's softening of the bow point (rollingSoftening) in the lab's model at this Z_t/Z_0.
-double softeningAt(double ztRatio);
+/// A rolling string's softening of the bow point (rollingSoftening) in the lab's model at this
+/// Z_t/Z_0, with the c_t / c the manifest states (unset: the model's own).
+double softeningAt(double ztRatio, std::optional<double> statedSpeedRatio = std::nullopt);
 /// A string that rolls readily (reference rigs draw Z_t/Z_0 1.2-8): the roll a model without
 /// torsion is tried against as a rig unknown, whose softening a free ramp scale starts from and
 /// which the reported scale's interval leaves room for when no torsion is named.
 constexpr double kReadilyRollingZt = 2.0;
 /// A named torsion's softening at its value and at the ends of its reported Z_t/Z_0 interval.
-std::array<double, 3> rollingSofteningOf(const Finding& f);
+std::array<double, 3> rollingSofteningOf(const Finding& f, std::optional<double> statedSpeedRatio = std::nullopt);
 /// What a finding's numbers can and cannot say beyond its table, in plain words for report.md:
 /// a reported interval that reaches the no-effect value, and what a torsion's Z_t/Z_0 rests on.
-std::string findingCaveats(const Finding& f);
+std::string findingCaveats(const Finding& f, std::optional<double> statedSpeedRatio = std::nullopt);
 
 /// A finding's evidence in plain words: which part of the comparison the extension mended most.
 std::string describe(const std::string& effect, const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after,

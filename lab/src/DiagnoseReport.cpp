@@ -194,15 +194,20 @@ bool clearOfNoEffect(const Finding& f, const std::string& name)
 
 double assumedTorsionSpeedRatio() { return modelWithEffects({"torsional_compliance"}, {}).string.torsionSpeedRatio; }
 
-double softeningAt(double ztRatio) { return rollingSoftening(modelWithEffects({"torsional_compliance"}, {{"zt_ratio", ztRatio}})); }
-
-std::array<double, 3> rollingSofteningOf(const Finding& f)
+double softeningAt(double ztRatio, std::optional<double> statedSpeedRatio)
 {
-    const auto [lo, hi] = reportedInterval(f, "zt_ratio");
-    return {softeningAt(f.parameters.at("zt_ratio")[0]), softeningAt(lo), softeningAt(hi)};
+    dsp::BowedStringConfig c = modelWithEffects({"torsional_compliance"}, {{"zt_ratio", ztRatio}});
+    if (statedSpeedRatio) c.string.torsionSpeedRatio = *statedSpeedRatio;
+    return rollingSoftening(c);
 }
 
-std::string findingCaveats(const Finding& f)
+std::array<double, 3> rollingSofteningOf(const Finding& f, std::optional<double> statedSpeedRatio)
+{
+    const auto [lo, hi] = reportedInterval(f, "zt_ratio");
+    return {softeningAt(f.parameters.at("zt_ratio")[0], statedSpeedRatio), softeningAt(lo, statedSpeedRatio), softeningAt(hi, statedSpeedRatio)};
+}
+
+std::string findingCaveats(const Finding& f, std::optional<double> statedSpeedRatio)
 {
     std::string text;
     for (const auto& [name, v] : f.parameters) {
@@ -214,13 +219,17 @@ std::string findingCaveats(const Finding& f)
                 ") reaches its no-effect value, " + noEffectValue(name) + ": the data favour the effect without ruling out its absence. ";
     }
     if (f.parameters.count("zt_ratio")) {
-        const auto [s, low, high] = rollingSofteningOf(f);
+        const auto [s, low, high] = rollingSofteningOf(f, statedSpeedRatio);
+        const std::string speed = statedSpeedRatio
+                                      ? "as the manifest states it, c_t = " + fmt(*statedSpeedRatio, "%.3g") +
+                                            " c; Z_t/Z_0 is as good as that measurement (10 % error in c_t/c, 10 % in Z_t/Z_0 the other way)"
+                                      : "taken as c_t = " + fmt(assumedTorsionSpeedRatio(), "%.2g") +
+                                            " c, the model's own (the manifest does not state it); strings measure about 4.5-6, and Z_t/Z_0 moves in inverse "
+                                            "proportion to c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0)";
         text += "What the ramps and first slips fix is how much softer the rolling string makes the bow point: a factor s = " +
                 fmt(s, "%.3f") + " (" + fmt(low, "%.3f") + " – " + fmt(high, "%.3f") +
-                "), the transverse stiffness in series with Z_t c_t against Z_0 c. Z_t/Z_0 follows from it with the torsional wave speed "
-                "taken as c_t = " + fmt(assumedTorsionSpeedRatio(), "%.2g") + " c; strings measure about 4.5-6, and Z_t/Z_0 moves in inverse proportion to "
-                "c_t/c (10 % faster torsional waves, 10 % lower Z_t/Z_0). The ramps also trade s one for one with the rig's tension "
-                "over bow position, which the fits know only within their priors. ";
+                "), the transverse stiffness in series with Z_t c_t against Z_0 c. Z_t/Z_0 follows from it with the torsional wave speed " +
+                speed + ". The ramps also trade s one for one with the rig's tension over bow position, which the fits know only within their priors. ";
     }
     // The shift is a length on the model's temperature axis, and the contact radius sets that
     // axis: seed 2063's strong-shift study ran the same rigs as drawn, at 300 um and with the
@@ -306,7 +315,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (!fs::is_directory(dir)) throw LabError(dir.string() + ": cannot create the output directory");
-    auto findingJson = [](const Finding& f) {
+    auto findingJson = [&d](const Finding& f) {
         json params = json::object();
         for (const auto& [name, v] : f.parameters) {
             const auto [lo, hi] = reportedInterval(f, name);
@@ -319,8 +328,9 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             params[name]["identified"] = !f.unidentified.count(name);
             if (!diag::noEffectValue(name).empty()) params[name]["clear_of_no_effect"] = diag::clearOfNoEffect(f, name);
             if (name == "zt_ratio") {
-                params[name]["torsion_speed_ratio_assumed"] = diag::assumedTorsionSpeedRatio();
-                const auto [s, low, high] = diag::rollingSofteningOf(f);
+                params[name]["torsion_speed_ratio"] = d.statedTorsionSpeedRatio.value_or(diag::assumedTorsionSpeedRatio());
+                params[name]["torsion_speed_ratio_stated"] = d.statedTorsionSpeedRatio.has_value();
+                const auto [s, low, high] = diag::rollingSofteningOf(f, d.statedTorsionSpeedRatio);
                 params[name]["rolling_softening"] = {{"value", s}, {"ci95", {low, high}}};
             }
         }
@@ -471,7 +481,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             md << "| " << name << " | " << fmt(v[0]) << " | " << fmt(lo) << " – " << fmt(hi) << " | " << fmt(v[1]) << " – " << fmt(v[2]) << " | "
                << range(f.curvature, name, " – ") << " | " << range(f.halves, name, " / ") << " | " << range(f.systematic, name, " / ") << " | " << (f.discrepancy.count(name) ? fmt(f.discrepancy.at(name)) : std::string("-")) << " |\n";
         }
-        if (const std::string caveats = diag::findingCaveats(f); !caveats.empty()) md << "\n" << caveats << "\n";
+        if (const std::string caveats = diag::findingCaveats(f, d.statedTorsionSpeedRatio); !caveats.empty()) md << "\n" << caveats << "\n";
         for (const auto& name : f.unidentified)
             md << "\n" << name << " is not identified: the errors do not change along it at the fit (no curvature), so its "
                << "interval is its whole search range and its value is whatever the search stopped at.\n";

@@ -218,6 +218,18 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
         set.qAtF0 = measuredQ("q_f0");
         set.qAt5kHz = measuredQ("q_5khz");
     }
+    // So do the torsional constants: the roll's softening involves Z_t c_t, its decay Q_t.
+    if (str.contains("torsion_speed_ratio") || str.contains("q_torsion")) {
+        const auto measured = [&](const char* key, double lo, double hi, const char* what) {
+            if (!str.contains(key))
+                fail(manifest, std::string("rig.string.") + key, "is missing (torsion_speed_ratio and q_torsion are stated together)");
+            const double v = positive(str, key, manifest, "rig.string.");
+            if (v < lo || v > hi) fail(manifest, std::string("rig.string.") + key, what);
+            return v;
+        };
+        set.torsionSpeedRatio = measured("torsion_speed_ratio", 1.2, 15.0, "must be a c_t / c from 1.2 to 15");
+        set.qTorsion = measured("q_torsion", 3.0, 1000.0, "must be a torsional Q from 3 to 1000");
+    }
     set.exciter = rig.value("exciter", "unknown");
     if (set.exciter != "bow" && set.exciter != "rod" && set.exciter != "unknown")
         fail(manifest, "rig.exciter", "must be \"bow\", \"rod\" or \"unknown\"");
@@ -367,6 +379,10 @@ void writeMeasurementSet(const fs::path& folder, const MeasurementSet& set, int 
         if (set.qAtF0 && set.qAt5kHz) {
             str["q_f0"] = *set.qAtF0;
             str["q_5khz"] = *set.qAt5kHz;
+        }
+        if (set.torsionSpeedRatio && set.qTorsion) {
+            str["torsion_speed_ratio"] = *set.torsionSpeedRatio;
+            str["q_torsion"] = *set.qTorsion;
         }
         json rig{{"string", str}, {"beta", set.beta}, {"exciter", set.exciter},
                  {"sensor", {{"quantity", "bridge_force"}, {"units", set.units}, {"sample_rate_hz", set.sampleRate}}}};

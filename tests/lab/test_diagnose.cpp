@@ -778,6 +778,59 @@ TEST(DiagnoseCalibration, AStatedStringQIsTheQTheModelPlays)
     }
 }
 
+// Consistency check on a model-made set whose string rolls (the model's c_t = 5.2 c, Q_t 30): a
+// manifest that states those constants simulates exactly what the unstated one does; stated
+// constants off the string's reach every simulation of a rolling model and none of a model that
+// does not roll, and the rolling model then fits the set worse than at the string's own. The
+// softening a roll is read at follows the stated c_t / c.
+TEST(DiagnoseCalibration, StatedTorsionalConstantsAreTheOnesARollPlays)
+{
+    diag::StringInfo info;
+    Diagnosis d;
+    SynthTruth truth;
+    SynthSpec spec;
+    spec.effects = {"torsional_compliance"};
+    spec.params = {{"zt_ratio", 1.6}};
+    spec.seed = 23;
+    spec.grid = 4;
+    const MeasurementSet set = modelSetFromDisk(spec, truth);
+    info = diag::stringInfoOf(set);
+    std::vector<diag::Prepared> strokes = diag::prepareStrokes(set, info, DiagnoseOptions{}, d);
+    const DiagnoseOptions o;
+    std::vector<std::size_t> all(strokes.size());
+    std::iota(all.begin(), all.end(), std::size_t(0));
+    const EffectModel rolling{{"torsional_compliance"}, {{"zt_ratio", 1.6}}}, still{};
+    auto errorsWith = [&](std::optional<double> speed, std::optional<double> q, const EffectModel& m) {
+        diag::StringInfo stated = info;
+        stated.torsionSpeedRatio = speed;
+        stated.qTorsion = q;
+        const diag::Engine engine(strokes, stated, o.simRate, std::nullopt, false);
+        const rosin::dsp::BowedStringConfig c = engine.config(m);
+        if (speed) {
+            EXPECT_EQ(c.string.torsionSpeedRatio, *speed);
+            EXPECT_EQ(c.string.qTorsion, *q);
+            if (c.waveguide.torsion) EXPECT_NEAR(diag::rollingSoftening(c), diag::softeningAt(1.6, speed), 1e-12);
+        }
+        std::vector<double> e;
+        for (const auto& x : engine.errors(m, all)) e.push_back(x.total());
+        return e;
+    };
+    const rosin::dsp::StringParams own;
+    const std::vector<double> unstated = errorsWith(std::nullopt, std::nullopt, rolling);
+    EXPECT_EQ(errorsWith(own.torsionSpeedRatio, own.qTorsion, rolling), unstated);
+    const std::vector<double> slow = errorsWith(3.0, 12.0, rolling);
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < slow.size(); ++i) moved += std::abs(slow[i] - unstated[i]) > 1e-6;
+    EXPECT_GE(moved, slow.size() - 2) << "c_t = 3 c left most strokes of a rolling model as they were";
+    const double meanOf = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); }(slow);
+    EXPECT_GT(meanOf, 1.2 * std::accumulate(unstated.begin(), unstated.end(), 0.0) / static_cast<double>(unstated.size()))
+        << "the string's own torsion fits its strokes better than one 40 % slower";
+    EXPECT_EQ(errorsWith(3.0, 12.0, still), errorsWith(std::nullopt, std::nullopt, still)) << "torsional constants reached a string that does not roll";
+    // s = 1 / (1 + 1 / (Z_t/Z_0 c_t/c)): slower torsional waves, a softer bow point at the same Z_t.
+    EXPECT_NEAR(diag::softeningAt(1.6, 3.0), 1.0 / (1.0 + 1.0 / (1.6 * 3.0)), 1e-12);
+    EXPECT_LT(diag::softeningAt(1.6, 3.0), diag::softeningAt(1.6));
+}
+
 // The one parameter table: each physical parameter belongs to a finding, each nuisance to the
 // calibration, and no name is both (the study's columns and the findings read the same table).
 TEST(DiagnoseParameters, PhysicalParametersBelongToFindingsAndNuisancesToTheCalibration)
@@ -960,7 +1013,13 @@ TEST(DiagnoseParameters, TheReportSaysWhenTheModelDiscrepancyReachesNoEffect)
     char expected[32];
     std::snprintf(expected, sizeof expected, "s = %.3f", diag::softeningAt(1.5));
     EXPECT_NE(text.find(expected), npos) << text;
-    EXPECT_NE(text.find("c_t = 5.2 c"), npos) << text;
+    EXPECT_NE(text.find("c_t = 5.2 c, the model's own"), npos) << text;
+    // A manifest that states c_t / c: the softening and the words are at the lab's value.
+    const std::string measured = diag::findingCaveats(strong, 4.6);
+    std::snprintf(expected, sizeof expected, "s = %.3f", diag::softeningAt(1.5, 4.6));
+    EXPECT_NE(measured.find(expected), npos) << measured;
+    EXPECT_NE(measured.find("as the manifest states it, c_t = 4.6 c"), npos) << measured;
+    EXPECT_NE(diag::softeningAt(1.5, 4.6), diag::softeningAt(1.5));
 
     Finding contact;
     contact.effect = "hertzian_contact";

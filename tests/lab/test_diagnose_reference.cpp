@@ -353,6 +353,13 @@ TEST(DiagnoseReference, RisingForceStrokesOfANullRigNameNothing)
             EXPECT_NE(c.meaning.find("the manifest does not state it"), std::string::npos) << c.meaning;
         }
     EXPECT_EQ(losses, 2);
+    for (const char* name : {"torsion_speed_ratio", "torsion_q"}) {
+        const auto c = std::find_if(o.d.calibration.begin(), o.d.calibration.end(), [&](const auto& x) { return x.name == name; });
+        ASSERT_NE(c, o.d.calibration.end()) << name;
+        EXPECT_EQ(c->value, std::string(name) == "torsion_q" ? rosin::dsp::StringParams{}.qTorsion : rosin::dsp::StringParams{}.torsionSpeedRatio);
+        EXPECT_NE(c->meaning.find("the manifest does not state it"), std::string::npos) << c->meaning;
+    }
+    EXPECT_FALSE(o.d.statedTorsionSpeedRatio.has_value());
     double peak = 0;
     for (const auto& f : o.d.measuredForce)
         for (double x : f) peak = std::max(peak, std::abs(x));

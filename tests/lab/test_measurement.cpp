@@ -363,6 +363,41 @@ TEST(MeasurementSet, AMeasuredStringQRoundTripsAndHalfAPairOrAnAbsurdOneIsRefuse
     fs::remove_all(d);
 }
 
+// A lab that measured its string's torsional resonances states c_t / c and Q_t together: the
+// pair survives a write and a read, and half a pair, a speed no string has or a Q outside any
+// measured one is refused naming the field.
+TEST(MeasurementSet, MeasuredTorsionalConstantsRoundTripAndHalfAPairOrAnAbsurdOneIsRefused)
+{
+    const fs::path d = freshDir("torsion");
+    MeasurementSet set = tinySet(6);
+    writeMeasurementSet(d / "none", set, SF_FORMAT_FLOAT);
+    const MeasurementSet silent = readMeasurementSet(d / "none");
+    EXPECT_FALSE(silent.torsionSpeedRatio.has_value());
+    EXPECT_FALSE(silent.qTorsion.has_value());
+    set.torsionSpeedRatio = 4.8;
+    set.qTorsion = 22.0;
+    writeMeasurementSet(d / "stated", set, SF_FORMAT_FLOAT);
+    const MeasurementSet back = readMeasurementSet(d / "stated");
+    ASSERT_TRUE(back.torsionSpeedRatio && back.qTorsion);
+    EXPECT_EQ(*back.torsionSpeedRatio, 4.8);
+    EXPECT_EQ(*back.qTorsion, 22.0);
+    EXPECT_FALSE(back.qAtF0.has_value()) << "the torsion's pair states nothing of the transverse Q";
+    writeMeasurementSet(d / "half", set, SF_FORMAT_FLOAT);
+    editManifest(d / "half", "\"q_torsion\"", "\"q_t\"");
+    std::string e = errorOf(d / "half");
+    EXPECT_NE(e.find("field 'rig.string.q_torsion' is missing"), std::string::npos) << e;
+    set.torsionSpeedRatio = 0.9; // slower than the transverse waves: no solid string
+    writeMeasurementSet(d / "slow", set, SF_FORMAT_FLOAT);
+    e = errorOf(d / "slow");
+    EXPECT_NE(e.find("field 'rig.string.torsion_speed_ratio' must be a c_t / c from 1.2 to 15"), std::string::npos) << e;
+    set.torsionSpeedRatio = 4.8;
+    set.qTorsion = 5000.0;
+    writeMeasurementSet(d / "ringing", set, SF_FORMAT_FLOAT);
+    e = errorOf(d / "ringing");
+    EXPECT_NE(e.find("field 'rig.string.q_torsion' must be a torsional Q from 3 to 1000"), std::string::npos) << e;
+    fs::remove_all(d);
+}
+
 // A set may mix gestures (gesture.kind "mixed"): each transient names its own kind and that
 // kind's fields; they survive a write and a read, and a transient that names none is refused.
 TEST(MeasurementSet, MixedGesturesRoundTripAndAStrokeWithoutItsKindIsRefused)

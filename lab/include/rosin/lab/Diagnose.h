@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -202,6 +203,9 @@ struct Diagnosis {
     double scale = 1.0;         ///< N per signal unit
     bool triggersDetected = false; ///< gesture starts estimated from pre-slip ramps
     std::vector<CalibrationValue> calibration;
+    /// The string's c_t / c as the manifest states it: a roll's Z_t/Z_0 is read at it (unset:
+    /// at the model's own).
+    std::optional<double> statedTorsionSpeedRatio;
     std::vector<RigUnknownTrial> rigUnknowns; ///< the systematic part of the findings' intervals
     Residual residual;
     std::vector<std::string> rules; ///< the naming rules and their thresholds, in words

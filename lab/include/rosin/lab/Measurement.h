@@ -53,6 +53,10 @@ struct MeasurementSet {
     /// The string's transverse Q as the lab measured it (rig.string.q_f0, rig.string.q_5khz: from
     /// the decays of its partials at the fundamental and near 5 kHz). Unset: the model's own.
     std::optional<double> qAtF0, qAt5kHz;
+    /// The string's torsional wave speed over its transverse one and its torsional Q as the lab
+    /// measured them (rig.string.torsion_speed_ratio, rig.string.q_torsion: from its torsional
+    /// resonances). Unset: the model's own (5.2 and 30). They matter only where the string rolls.
+    std::optional<double> torsionSpeedRatio, qTorsion;
     std::string exciter = "unknown";   ///< bow, rod or unknown
     std::optional<double> ambient;     ///< C
     std::string units = "N";           ///< N (calibrated) or V (scale unknown)
