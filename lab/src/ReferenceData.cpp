@@ -173,24 +173,25 @@ const RigPrior& statedError(const std::string& name)
     const auto& pr = referenceRigPriors();
     const auto it = std::find_if(pr.begin(), pr.end(), [&](const RigPrior& r) { return r.key == key; });
     if ((name != "tension" && name != "beta") || it == pr.end())
-        throw LabError("--stated-uncertainty: unknown rig value '" + name + "' (tension, beta, q)");
+        throw LabError("--stated-uncertainty: unknown rig value '" + name + "' (tension, beta, q, torsion)");
     return *it;
 }
 
-/// How far a lab's measured Q may stand off the string's (a decay fit's error).
-constexpr double kQMeasurementSpreadMax = 0.3;
+/// How far a lab's measured Q or torsional constants may stand off the string's (a decay or
+/// resonance fit's error).
+constexpr double kStringMeasurementSpreadMax = 0.3;
 
 void checkStatedUncertainty(const std::string& name, double u)
 {
-    // Tension and beta bound the rig's own error, so no wider than the generator draws it; q
-    // bounds how far the manifest's Q stands off the rig's.
-    const bool q = name == "q";
-    const double widest = q ? kQMeasurementSpreadMax : statedError(name).hi;
+    // Tension and beta bound the rig's own error, so no wider than the generator draws it; q and
+    // torsion bound how far the manifest's values stand off the rig's.
+    const bool measured = name == "q" || name == "torsion";
+    const double widest = measured ? kStringMeasurementSpreadMax : statedError(name).hi;
     if (!std::isfinite(u) || u < 0.001 || u > widest) {
         char range[48];
         std::snprintf(range, sizeof range, "a fraction from 0.001 to %g", widest);
         throw LabError("--stated-uncertainty: " + name + " must be " + range +
-                       (q ? " (how far the stated Q stands off the string's)" : " (the generator's own spread of its error)"));
+                       (measured ? " (how far the stated value stands off the string's)" : " (the generator's own spread of its error)"));
     }
 }
 } // namespace
@@ -378,6 +379,15 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
         set.qAt5kHz = rig["q_high"] * (1.0 + e5);
         rig["q_f0_stated"] = *set.qAtF0;
         rig["q_5khz_stated"] = *set.qAt5kHz;
+    }
+    // Likewise a lab that measured its string's torsional resonances (their spacing and widths).
+    if (const auto t = spec.statedUncertainty.find("torsion"); t != spec.statedUncertainty.end()) {
+        std::mt19937_64 tr(spec.seed * 6364136223846793005ull + 1442695040888963407ull);
+        const double ec = t->second * (2.0 * u(tr) - 1.0), eq = t->second * (2.0 * u(tr) - 1.0);
+        set.torsionSpeedRatio = rig["torsion_speed_ratio"] * (1.0 + ec);
+        set.qTorsion = rig["q_torsion"] * (1.0 + eq);
+        rig["torsion_speed_ratio_stated"] = *set.torsionSpeedRatio;
+        rig["q_torsion_stated"] = *set.qTorsion;
     }
     // The lab's own steady-sliding measurement of this rosin, 1 % scatter.
     {

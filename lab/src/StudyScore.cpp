@@ -335,7 +335,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         md << "Rigs of a lab that states what it measured: "
            << joined(plan["stated_uncertainty"], [](const json& v) { return fmt(" +-%.3g %%", 100.0 * v.get<double>()); })
            << " in every manifest, each rig's error drawn within it (the generator's own spread: tension +-4 %, bow position +-3 %; "
-              "q: the string's Q at f0 and 5 kHz stated within that of the rig's).\n";
+              "q: the string's Q at f0 and 5 kHz stated within that of the rig's; torsion: its c_t / c and torsional Q likewise).\n";
         summary["stated_uncertainty"] = plan["stated_uncertainty"];
     }
     md << "\n";

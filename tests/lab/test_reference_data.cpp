@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <optional>
 
 #include "rosin/dsp/StringParams.h"
@@ -258,7 +259,9 @@ TEST(ReferenceSynthData, StatedUncertaintiesAreParsedOrRefusedByName)
     EXPECT_EQ(stated.at("tension"), 0.01);
     EXPECT_EQ(stated.at("beta"), 0.005);
     const auto refusal = [](const std::vector<std::string>& args) { return refusalOf(parseStatedUncertainties, args); };
-    EXPECT_NE(refusal({"length=0.01"}).find("unknown rig value 'length' (tension, beta, q)"), std::string::npos);
+    EXPECT_NE(refusal({"length=0.01"}).find("unknown rig value 'length' (tension, beta, q, torsion)"), std::string::npos);
+    EXPECT_EQ(parseStatedUncertainties({"torsion=0.05"}).at("torsion"), 0.05);
+    EXPECT_NE(refusal({"torsion=0.4"}).find("torsion must be a fraction from 0.001 to 0.3"), std::string::npos);
     EXPECT_EQ(parseStatedUncertainties({"q=0.1"}).at("q"), 0.1);
     EXPECT_NE(refusal({"q=0.5"}).find("q must be a fraction from 0.001 to 0.3"), std::string::npos);
     EXPECT_NE(refusal({"q=0"}).find("q must be a fraction"), std::string::npos);
@@ -308,40 +311,71 @@ TEST(ReferenceSynthData, AStatedUncertaintyBoundsTheRigsErrorAndTheManifestSaysI
     EXPECT_THROW(synthesize(spec, measured), LabError) << "the model generator has no rig to measure";
 }
 
-// A lab that measured its string's Q to +-10 %: the manifest states Q at f0 and at 5 kHz within
-// that of the rig's own (each end its own error), and the rig, the hidden parameters and every
-// recording are those of the same rig unmeasured. The model-on-rig generator states the Q its
-// string had (the model's own).
-TEST(ReferenceSynthData, AStatedQIsTheRigsWithinItsFractionAndMovesNothingElse)
+// A lab that measured its string's Q (+-10 %) or its torsional constants (+-5 %): the manifest
+// states each pair within that of the rig's own (each value its own error), and the rig, the
+// hidden parameters and every recording are those of the same rig unmeasured. The model-on-rig
+// generator states the values its string had (the model's own).
+TEST(ReferenceSynthData, StatedStringConstantsAreTheRigsWithinTheirFractionAndMoveNothingElse)
 {
-    SynthSpec spec = small(34);
-    spec.effects = {"torsional_compliance"};
-    SynthTruth unmeasured, measured;
-    const MeasurementSet plain = synthesize(spec, unmeasured);
-    EXPECT_FALSE(plain.qAtF0.has_value());
-    spec.statedUncertainty = {{"q", 0.1}};
-    const MeasurementSet set = synthesize(spec, measured);
-    ASSERT_TRUE(set.qAtF0 && set.qAt5kHz);
-    const double e0 = *set.qAtF0 / unmeasured.rig.at("q_low") - 1.0, e5 = *set.qAt5kHz / unmeasured.rig.at("q_high") - 1.0;
-    EXPECT_LE(std::abs(e0), 0.1);
-    EXPECT_LE(std::abs(e5), 0.1);
-    EXPECT_NE(e0, e5) << "one error drawn for both ends";
-    EXPECT_EQ(measured.rig.at("q_f0_stated"), *set.qAtF0);
-    for (const auto& [key, value] : unmeasured.rig) EXPECT_EQ(measured.rig.at(key), value) << key << " moved";
-    EXPECT_EQ(measured.params, unmeasured.params);
-    ASSERT_EQ(set.strokes.size(), plain.strokes.size());
-    for (std::size_t i = 0; i < set.strokes.size(); ++i) EXPECT_EQ(set.strokes[i].signal, plain.strokes[i].signal) << "stroke " << i;
-    // Another seed draws other errors.
-    SynthSpec other = spec;
-    other.seed = 35;
-    SynthTruth otherTruth;
-    const MeasurementSet otherSet = synthesize(other, otherTruth);
-    EXPECT_NE(*otherSet.qAtF0 / otherTruth.rig.at("q_low") - 1.0, e0);
-    spec.generator = "model-on-rig";
-    SynthTruth modelTruth;
-    const MeasurementSet modelSet = synthesize(spec, modelTruth);
-    EXPECT_LE(std::abs(*modelSet.qAtF0 / rosin::dsp::StringParams{}.qLow - 1.0), 0.1);
-    EXPECT_LE(std::abs(*modelSet.qAt5kHz / rosin::dsp::StringParams{}.qHigh - 1.0), 0.1);
+    struct Pair {
+        const char* name;
+        double fraction;
+        const char *rigA, *rigB, *statedA;
+        std::function<std::pair<std::optional<double>, std::optional<double>>(const MeasurementSet&)> stated;
+        double modelA, modelB;
+    };
+    const rosin::dsp::StringParams own;
+    const Pair pairs[]{{"q", 0.1, "q_low", "q_high", "q_f0_stated", [](const MeasurementSet& m) { return std::pair{m.qAtF0, m.qAt5kHz}; },
+                        own.qLow, own.qHigh},
+                       {"torsion", 0.05, "torsion_speed_ratio", "q_torsion", "torsion_speed_ratio_stated",
+                        [](const MeasurementSet& m) { return std::pair{m.torsionSpeedRatio, m.qTorsion}; }, own.torsionSpeedRatio, own.qTorsion}};
+    SynthSpec base = small(34);
+    base.effects = {"torsional_compliance"};
+    SynthTruth unmeasured;
+    const MeasurementSet plain = synthesize(base, unmeasured);
+    for (const Pair& p : pairs) {
+        SCOPED_TRACE(p.name);
+        EXPECT_FALSE(p.stated(plain).first.has_value());
+        SynthSpec spec = base;
+        spec.statedUncertainty = {{p.name, p.fraction}};
+        SynthTruth measured;
+        const MeasurementSet set = synthesize(spec, measured);
+        const auto [a, b] = p.stated(set);
+        ASSERT_TRUE(a && b);
+        const double ea = *a / unmeasured.rig.at(p.rigA) - 1.0, eb = *b / unmeasured.rig.at(p.rigB) - 1.0;
+        EXPECT_LE(std::abs(ea), p.fraction);
+        EXPECT_LE(std::abs(eb), p.fraction);
+        EXPECT_NE(ea, eb) << "one error drawn for both";
+        EXPECT_EQ(measured.rig.at(p.statedA), *a);
+        for (const auto& [key, value] : unmeasured.rig) EXPECT_EQ(measured.rig.at(key), value) << key << " moved";
+        EXPECT_EQ(measured.params, unmeasured.params);
+        ASSERT_EQ(set.strokes.size(), plain.strokes.size());
+        for (std::size_t i = 0; i < set.strokes.size(); ++i) EXPECT_EQ(set.strokes[i].signal, plain.strokes[i].signal) << "stroke " << i;
+        // Another seed draws other errors.
+        SynthSpec other = spec;
+        other.seed = 35;
+        SynthTruth otherTruth;
+        const MeasurementSet otherSet = synthesize(other, otherTruth);
+        EXPECT_NE(*p.stated(otherSet).first / otherTruth.rig.at(p.rigA) - 1.0, ea);
+        spec.generator = "model-on-rig";
+        SynthTruth modelTruth;
+        const auto [ma, mb] = p.stated(synthesize(spec, modelTruth));
+        EXPECT_LE(std::abs(*ma / p.modelA - 1.0), p.fraction);
+        EXPECT_LE(std::abs(*mb / p.modelB - 1.0), p.fraction);
+    }
+    // Both stated at once: each pair's errors come from a stream of its own.
+    SynthSpec both = base;
+    both.statedUncertainty = {{"q", 0.1}, {"torsion", 0.05}};
+    SynthTruth bothTruth, qTruth, torsionTruth;
+    const MeasurementSet bothSet = synthesize(both, bothTruth);
+    SynthSpec qOnly = base, torsionOnly = base;
+    qOnly.statedUncertainty = {{"q", 0.1}};
+    torsionOnly.statedUncertainty = {{"torsion", 0.05}};
+    const MeasurementSet qSet = synthesize(qOnly, qTruth), torsionSet = synthesize(torsionOnly, torsionTruth);
+    EXPECT_EQ(bothSet.qAtF0, qSet.qAtF0);
+    EXPECT_EQ(bothSet.qAt5kHz, qSet.qAt5kHz);
+    EXPECT_EQ(bothSet.torsionSpeedRatio, torsionSet.torsionSpeedRatio);
+    EXPECT_EQ(bothSet.qTorsion, torsionSet.qTorsion);
 }
 
 // The one reading of "is this text a number" behind every command-line value and data field.

@@ -62,7 +62,7 @@ struct StudyCommand {
         cmd->add_option("--stated-uncertainty", statedUncertainties,
                         "Rigs of a lab that measured them, NAME=FRACTION (tension, beta): each rig's error is drawn within +-FRACTION "
                         "and its manifest states it, e.g. tension=0.01 beta=0.01; q=FRACTION: each manifest states its string's "
-                        "Q at f0 and 5 kHz within +-FRACTION of the rig's");
+                        "Q at f0 and 5 kHz within +-FRACTION of the rig's; torsion=FRACTION: its c_t / c and torsional Q likewise");
         addSearchFlags(*cmd, options.diagnose);
         cmd->add_flag("--keep-sets", options.keepSets, "Keep the generated WAV sets");
         cmd->add_option("--only", options.only, "Run only these sets (indices, e.g. 3,13; the folder's plan stays the whole study)")->delimiter(',')->check(CLI::NonNegativeNumber);

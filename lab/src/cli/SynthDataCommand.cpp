@@ -58,7 +58,7 @@ struct SynthDataCommand {
         synthCmd->add_option("--stated-uncertainty", statedUncertainties,
                              "Reference: a lab that measured its rig, NAME=FRACTION (tension, beta): the rig's error is drawn within "
                              "+-FRACTION and the manifest states it; q: the manifest states the string's Q at f0 and 5 kHz within "
-                             "+-FRACTION of the rig's");
+                             "+-FRACTION of the rig's; torsion: its c_t / c and torsional Q likewise");
         synthCmd->add_option("--oversampling", synth.oversampling, "Reference: simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         synthCmd->add_option("--gesture", synth.gesture, "Reference: guettler, exp_speed (v0/tv x F), exp_force (speed x F0) or mixed")
             ->check(CLI::IsMember({"guettler", "exp_speed", "exp_force", "mixed"}))->capture_default_str();
