@@ -145,7 +145,7 @@ dsp::BowedStringConfig Engine::config(const EffectModel& m) const
     // The string is tuned to the manifest's pitch: a tension off by s moves its mass with it.
     c.string.length = info_.length;
     c.string.tension = info_.tension * get("tension_scale");
-    c.string.massPerLength = c.string.tension / std::pow(2.0 * info_.length * info_.f0, 2.0);
+    c.string.tuneTo(info_.f0);
     // A measured Q replaces the model's: the string's losses shape how a transient settles and
     // trade with a roll's (docs/diagnosis-study.md), and no Guettler set can fit them itself.
     if (info_.qAtF0 && info_.qAt5kHz) {

@@ -77,7 +77,7 @@ dsp::BowedStringConfig modelOnRig(const std::vector<std::string>& effects, const
     // Tuned to the manifest's pitch: a tension off the maker's figure moves the mass with it, as
     // the diagnosis's tension nuisance does.
     c.string.tension = value("tension_n");
-    c.string.massPerLength = c.string.tension / std::pow(2.0 * c.string.length * f0, 2.0);
+    c.string.tuneTo(f0);
     c.friction.thermal.rodEffusivity = value("rod_effusivity");
     return c;
 }

@@ -149,7 +149,7 @@ struct ModelOptions {
             keepPitch |= name == "tension_n" || name == "length_m";
         }
         // A new tension or length keeps the string's pitch: its mass per length follows.
-        if (keepPitch) st.massPerLength = st.tension / std::pow(2.0 * st.length * f0, 2.0);
+        if (keepPitch) st.tuneTo(f0);
         if (const std::string problem = st.validate(); !problem.empty()) throw LabError("--set: " + problem);
         return c;
     }

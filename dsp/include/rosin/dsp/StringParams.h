@@ -24,13 +24,16 @@ struct StringParams {
     double fundamental() const { return waveSpeed() / (2.0 * length); }
     double torsionImpedance() const { return torsionImpedanceRatio * impedance(); }
 
+    /// Tunes the string to `f0` as a player does, by its tension: the mass per length that
+    /// sounds f0 at this length and tension (so a tension off the maker's figure moves it).
+    void tuneTo(double f0) { massPerLength = tension / std::pow(2.0 * length * f0, 2.0); }
+
     /// The PHYSICS.md 1.6 reference: open cello D string of the Galluzzo rig comparisons.
     /// m is derived so that f0 = 146.83 Hz with L = 0.69 m and T = 102.6 N.
     static StringParams celloD()
     {
         StringParams p;
-        const double f0 = 146.83;
-        p.massPerLength = p.tension / std::pow(2.0 * p.length * f0, 2.0);
+        p.tuneTo(146.83);
         return p;
     }
 
