@@ -133,19 +133,21 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     Engine engine(strokes, info, o.simRate, steady, set.units == "V");
     EffectModel current;
     {
-        // Which string losses the model plays (Engine::config decides): a lab's measured Q, or the model's own.
+        // Which string constants the model plays (Engine::config decides): what the lab measured,
+        // or the model's own. Not fitted, so each interval is its value.
         const dsp::StringParams played = engine.config(current).string;
-        const std::string whence = info.qAtF0 && info.qAt5kHz ? "as the manifest states it (rig.string.q_f0, q_5khz)" : "the model's own: the manifest does not state it";
-        d.calibration.push_back({"string_q_f0", "the string's transverse Q at f0, " + whence, played.qLow, played.qLow, played.qLow});
-        d.calibration.push_back({"string_q_5khz", "the string's transverse Q at 5 kHz, " + whence, played.qHigh, played.qHigh, played.qHigh});
-        if (info.torsionSpeedRatio && info.qTorsion) d.statedTorsionSpeedRatio = played.torsionSpeedRatio;
-        const std::string torsional = info.torsionSpeedRatio && info.qTorsion
-                                          ? "as the manifest states it (rig.string.torsion_speed_ratio, q_torsion)"
-                                          : "the model's own: the manifest does not state it";
-        d.calibration.push_back({"torsion_speed_ratio", "the string's torsional wave speed over its transverse one, played where a roll is tried, " + torsional,
-                                 played.torsionSpeedRatio, played.torsionSpeedRatio, played.torsionSpeedRatio});
-        d.calibration.push_back({"torsion_q", "the string's torsional Q, played where a roll is tried, " + torsional, played.qTorsion,
-                                 played.qTorsion, played.qTorsion});
+        const auto given = [&](const char* name, const std::string& meaning, double value) {
+            d.calibration.push_back({name, meaning, value, value, value});
+        };
+        const std::string silent = "the model's own: the manifest does not state it";
+        const std::string losses = info.statesQ() ? "as the manifest states it (rig.string.q_f0, q_5khz)" : silent;
+        given("string_q_f0", "the string's transverse Q at f0, " + losses, played.qLow);
+        given("string_q_5khz", "the string's transverse Q at 5 kHz, " + losses, played.qHigh);
+        const std::string torsional = info.statesTorsion() ? "as the manifest states it (rig.string.torsion_speed_ratio, q_torsion)" : silent;
+        given("torsion_speed_ratio", "the string's torsional wave speed over its transverse one, played where a roll is tried, " + torsional,
+              played.torsionSpeedRatio);
+        given("torsion_q", "the string's torsional Q, played where a roll is tried, " + torsional, played.qTorsion);
+        if (info.statesTorsion()) d.statedTorsionSpeedRatio = played.torsionSpeedRatio;
     }
     if (o.fitNuisances) {
         say("calibration: tension and bow position", 0.0);

@@ -148,14 +148,14 @@ dsp::BowedStringConfig Engine::config(const EffectModel& m) const
     c.string.tuneTo(info_.f0);
     // A measured Q replaces the model's: the string's losses shape how a transient settles and
     // trade with a roll's (docs/diagnosis-study.md), and no Guettler set can fit them itself.
-    if (info_.qAtF0 && info_.qAt5kHz) {
+    if (info_.statesQ()) {
         c.string.qLow = *info_.qAtF0;
         c.string.qHigh = *info_.qAt5kHz;
         c.string.qHighFrequency = 5000.0;
     }
     // So do measured torsional constants: a roll's softening is 1 / (1 + Z_0 c / (Z_t c_t)), so
     // a c_t off the string's moves the Z_t/Z_0 a roll is read at (docs/diagnosis-study.md).
-    if (info_.torsionSpeedRatio && info_.qTorsion) {
+    if (info_.statesTorsion()) {
         c.string.torsionSpeedRatio = *info_.torsionSpeedRatio;
         c.string.qTorsion = *info_.qTorsion;
     }

@@ -30,6 +30,9 @@ struct StringInfo {
     std::optional<double> qAtF0, qAt5kHz;
     /// The string's c_t / c and torsional Q as the manifest states them; unset: the model's own.
     std::optional<double> torsionSpeedRatio, qTorsion;
+    /// Each pair counts only whole (the manifest reader refuses half of one).
+    bool statesQ() const { return qAtF0 && qAt5kHz; }
+    bool statesTorsion() const { return torsionSpeedRatio && qTorsion; }
 };
 
 struct Prepared {

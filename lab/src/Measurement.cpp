@@ -207,28 +207,24 @@ MeasurementSet readMeasurementSet(const fs::path& folder)
     };
     if (str.contains("tension_uncertainty")) set.tensionUncertainty = uncertainty(str, "tension_uncertainty", "rig.string.");
     if (rig.contains("beta_uncertainty")) set.betaUncertainty = uncertainty(rig, "beta_uncertainty", "rig.");
+    // A string constant the lab measured, one of a pair that is stated together: it must be there
+    // once its partner is, and within what any string has.
+    const auto measured = [&](const char* key, const char* pair, double lo, double hi, const char* what) {
+        if (!str.contains(key)) fail(manifest, std::string("rig.string.") + key, std::string("is missing (") + pair + " are stated together)");
+        const double v = positive(str, key, manifest, "rig.string.");
+        if (v < lo || v > hi) fail(manifest, std::string("rig.string.") + key, what);
+        return v;
+    };
     // A measured Q comes as a pair: the model's losses are set by both ends of its band.
     if (str.contains("q_f0") || str.contains("q_5khz")) {
-        const auto measuredQ = [&](const char* key) {
-            if (!str.contains(key)) fail(manifest, std::string("rig.string.") + key, "is missing (q_f0 and q_5khz are stated together)");
-            const double q = positive(str, key, manifest, "rig.string.");
-            if (q < 5.0 || q > 1e5) fail(manifest, std::string("rig.string.") + key, "must be a Q from 5 to 100000");
-            return q;
-        };
-        set.qAtF0 = measuredQ("q_f0");
-        set.qAt5kHz = measuredQ("q_5khz");
+        set.qAtF0 = measured("q_f0", "q_f0 and q_5khz", 5.0, 1e5, "must be a Q from 5 to 100000");
+        set.qAt5kHz = measured("q_5khz", "q_f0 and q_5khz", 5.0, 1e5, "must be a Q from 5 to 100000");
     }
     // So do the torsional constants: the roll's softening involves Z_t c_t, its decay Q_t.
     if (str.contains("torsion_speed_ratio") || str.contains("q_torsion")) {
-        const auto measured = [&](const char* key, double lo, double hi, const char* what) {
-            if (!str.contains(key))
-                fail(manifest, std::string("rig.string.") + key, "is missing (torsion_speed_ratio and q_torsion are stated together)");
-            const double v = positive(str, key, manifest, "rig.string.");
-            if (v < lo || v > hi) fail(manifest, std::string("rig.string.") + key, what);
-            return v;
-        };
-        set.torsionSpeedRatio = measured("torsion_speed_ratio", 1.2, 15.0, "must be a c_t / c from 1.2 to 15");
-        set.qTorsion = measured("q_torsion", 3.0, 1000.0, "must be a torsional Q from 3 to 1000");
+        const char* pair = "torsion_speed_ratio and q_torsion";
+        set.torsionSpeedRatio = measured("torsion_speed_ratio", pair, 1.2, 15.0, "must be a c_t / c from 1.2 to 15");
+        set.qTorsion = measured("q_torsion", pair, 3.0, 1000.0, "must be a torsional Q from 3 to 1000");
     }
     set.exciter = rig.value("exciter", "unknown");
     if (set.exciter != "bow" && set.exciter != "rod" && set.exciter != "unknown")

@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -370,24 +371,28 @@ MeasurementSet synthesizeReference(const SynthSpec& spec, SynthTruth& truth, con
     set.gesture = spec.gesture;
     if (const auto t = spec.statedUncertainty.find("tension"); t != spec.statedUncertainty.end()) set.tensionUncertainty = t->second;
     if (const auto b = spec.statedUncertainty.find("beta"); b != spec.statedUncertainty.end()) set.betaUncertainty = b->second;
-    // A lab that measured its string's Q (a pluck's decays) to +-U states it; the error is drawn
-    // from a stream of its own, so the rig and every other draw stay those of the unmeasured rig.
-    if (const auto q = spec.statedUncertainty.find("q"); q != spec.statedUncertainty.end()) {
-        std::mt19937_64 qr(spec.seed * 2862933555777941757ull + 3037000493ull);
-        const double e0 = q->second * (2.0 * u(qr) - 1.0), e5 = q->second * (2.0 * u(qr) - 1.0);
-        set.qAtF0 = rig["q_low"] * (1.0 + e0);
-        set.qAt5kHz = rig["q_high"] * (1.0 + e5);
-        rig["q_f0_stated"] = *set.qAtF0;
-        rig["q_5khz_stated"] = *set.qAt5kHz;
-    }
-    // Likewise a lab that measured its string's torsional resonances (their spacing and widths).
-    if (const auto t = spec.statedUncertainty.find("torsion"); t != spec.statedUncertainty.end()) {
-        std::mt19937_64 tr(spec.seed * 6364136223846793005ull + 1442695040888963407ull);
-        const double ec = t->second * (2.0 * u(tr) - 1.0), eq = t->second * (2.0 * u(tr) - 1.0);
-        set.torsionSpeedRatio = rig["torsion_speed_ratio"] * (1.0 + ec);
-        set.qTorsion = rig["q_torsion"] * (1.0 + eq);
-        rig["torsion_speed_ratio_stated"] = *set.torsionSpeedRatio;
-        rig["q_torsion_stated"] = *set.qTorsion;
+    // A lab that measured a pair of its string's constants to +-U (its Q from a pluck's decays, its
+    // torsion from the torsional resonances' spacing and widths) states each off by its own error,
+    // drawn from a stream of the pair's own, so the rig and every other draw stay those of the
+    // unmeasured rig and one pair's statement does not move the other's.
+    struct MeasuredPair {
+        const char* name;
+        std::uint64_t streamScale, streamOffset;
+        std::array<const char*, 2> rigKeys, truthKeys;
+        std::array<std::optional<double>*, 2> stated;
+    };
+    for (const MeasuredPair& p : {MeasuredPair{"q", 2862933555777941757ull, 3037000493ull, {"q_low", "q_high"}, {"q_f0_stated", "q_5khz_stated"},
+                                               {&set.qAtF0, &set.qAt5kHz}},
+                                  MeasuredPair{"torsion", 6364136223846793005ull, 1442695040888963407ull, {"torsion_speed_ratio", "q_torsion"},
+                                               {"torsion_speed_ratio_stated", "q_torsion_stated"}, {&set.torsionSpeedRatio, &set.qTorsion}}}) {
+        const auto fraction = spec.statedUncertainty.find(p.name);
+        if (fraction == spec.statedUncertainty.end()) continue;
+        std::mt19937_64 stream(spec.seed * p.streamScale + p.streamOffset);
+        for (std::size_t k = 0; k < 2; ++k) {
+            const double error = fraction->second * (2.0 * u(stream) - 1.0);
+            *p.stated[k] = rig[p.rigKeys[k]] * (1.0 + error);
+            rig[p.truthKeys[k]] = **p.stated[k];
+        }
     }
     // The lab's own steady-sliding measurement of this rosin, 1 % scatter.
     {

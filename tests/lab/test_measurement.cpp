@@ -58,6 +58,20 @@ std::string errorOf(const fs::path& folder)
     return "";
 }
 
+/// The set written to `folder` as a lab's files and read back.
+MeasurementSet writtenAndRead(const fs::path& folder, const MeasurementSet& set)
+{
+    writeMeasurementSet(folder, set, SF_FORMAT_FLOAT);
+    return readMeasurementSet(folder);
+}
+
+/// What the reader says of the set once it is written to `folder` ("" when it reads).
+std::string refusalWhenWritten(const fs::path& folder, const MeasurementSet& set)
+{
+    writeMeasurementSet(folder, set, SF_FORMAT_FLOAT);
+    return errorOf(folder);
+}
+
 std::string fileBytes(const fs::path& f)
 {
     std::ifstream in(f, std::ios::binary);
@@ -308,25 +322,21 @@ TEST(MeasurementSet, TheRigsStatedPriorsRoundTripAndAnAbsurdOneIsRefused)
 {
     const fs::path d = freshDir("priors");
     MeasurementSet set = tinySet(6);
-    writeMeasurementSet(d / "none", set, SF_FORMAT_FLOAT);
-    const MeasurementSet plain = readMeasurementSet(d / "none");
+    const MeasurementSet plain = writtenAndRead(d / "none", set);
     EXPECT_FALSE(plain.tensionUncertainty.has_value());
     EXPECT_FALSE(plain.betaUncertainty.has_value());
     set.tensionUncertainty = 0.01;
     set.betaUncertainty = 0.005;
-    writeMeasurementSet(d / "stated", set, SF_FORMAT_FLOAT);
-    const MeasurementSet back = readMeasurementSet(d / "stated");
+    const MeasurementSet back = writtenAndRead(d / "stated", set);
     ASSERT_TRUE(back.tensionUncertainty && back.betaUncertainty);
     EXPECT_EQ(*back.tensionUncertainty, 0.01);
     EXPECT_EQ(*back.betaUncertainty, 0.005);
     set.tensionUncertainty = 0.5; // +-50 %: not a measured rig
-    writeMeasurementSet(d / "absurd", set, SF_FORMAT_FLOAT);
-    std::string e = errorOf(d / "absurd");
+    std::string e = refusalWhenWritten(d / "absurd", set);
     EXPECT_NE(e.find("manifest.json: field 'rig.string.tension_uncertainty' must be a fraction"), std::string::npos) << e;
     set.tensionUncertainty.reset();
     set.betaUncertainty = -0.01;
-    writeMeasurementSet(d / "negative", set, SF_FORMAT_FLOAT);
-    e = errorOf(d / "negative");
+    e = refusalWhenWritten(d / "negative", set);
     EXPECT_NE(e.find("field 'rig.beta_uncertainty'"), std::string::npos) << e;
     fs::remove_all(d);
 }
@@ -338,12 +348,10 @@ TEST(MeasurementSet, AMeasuredStringQRoundTripsAndHalfAPairOrAnAbsurdOneIsRefuse
 {
     const fs::path d = freshDir("stringq");
     MeasurementSet set = tinySet(6);
-    writeMeasurementSet(d / "none", set, SF_FORMAT_FLOAT);
-    EXPECT_FALSE(readMeasurementSet(d / "none").qAtF0.has_value());
+    EXPECT_FALSE(writtenAndRead(d / "none", set).qAtF0.has_value());
     set.qAtF0 = 420.0;
     set.qAt5kHz = 130.0;
-    writeMeasurementSet(d / "stated", set, SF_FORMAT_FLOAT);
-    const MeasurementSet back = readMeasurementSet(d / "stated");
+    const MeasurementSet back = writtenAndRead(d / "stated", set);
     ASSERT_TRUE(back.qAtF0 && back.qAt5kHz);
     EXPECT_EQ(*back.qAtF0, 420.0);
     EXPECT_EQ(*back.qAt5kHz, 130.0);
@@ -353,12 +361,10 @@ TEST(MeasurementSet, AMeasuredStringQRoundTripsAndHalfAPairOrAnAbsurdOneIsRefuse
     std::string e = errorOf(d / "half");
     EXPECT_NE(e.find("field 'rig.string.q_5khz' is missing"), std::string::npos) << e;
     set.qAtF0 = 2.0; // a string that rings for less than a period
-    writeMeasurementSet(d / "absurd", set, SF_FORMAT_FLOAT);
-    e = errorOf(d / "absurd");
+    e = refusalWhenWritten(d / "absurd", set);
     EXPECT_NE(e.find("field 'rig.string.q_f0' must be a Q from 5 to 100000"), std::string::npos) << e;
     set.qAtF0 = -400.0;
-    writeMeasurementSet(d / "negative", set, SF_FORMAT_FLOAT);
-    e = errorOf(d / "negative");
+    e = refusalWhenWritten(d / "negative", set);
     EXPECT_NE(e.find("rig.string.q_f0"), std::string::npos) << e;
     fs::remove_all(d);
 }
@@ -370,14 +376,12 @@ TEST(MeasurementSet, MeasuredTorsionalConstantsRoundTripAndHalfAPairOrAnAbsurdOn
 {
     const fs::path d = freshDir("torsion");
     MeasurementSet set = tinySet(6);
-    writeMeasurementSet(d / "none", set, SF_FORMAT_FLOAT);
-    const MeasurementSet silent = readMeasurementSet(d / "none");
+    const MeasurementSet silent = writtenAndRead(d / "none", set);
     EXPECT_FALSE(silent.torsionSpeedRatio.has_value());
     EXPECT_FALSE(silent.qTorsion.has_value());
     set.torsionSpeedRatio = 4.8;
     set.qTorsion = 22.0;
-    writeMeasurementSet(d / "stated", set, SF_FORMAT_FLOAT);
-    const MeasurementSet back = readMeasurementSet(d / "stated");
+    const MeasurementSet back = writtenAndRead(d / "stated", set);
     ASSERT_TRUE(back.torsionSpeedRatio && back.qTorsion);
     EXPECT_EQ(*back.torsionSpeedRatio, 4.8);
     EXPECT_EQ(*back.qTorsion, 22.0);
@@ -387,13 +391,11 @@ TEST(MeasurementSet, MeasuredTorsionalConstantsRoundTripAndHalfAPairOrAnAbsurdOn
     std::string e = errorOf(d / "half");
     EXPECT_NE(e.find("field 'rig.string.q_torsion' is missing"), std::string::npos) << e;
     set.torsionSpeedRatio = 0.9; // slower than the transverse waves: no solid string
-    writeMeasurementSet(d / "slow", set, SF_FORMAT_FLOAT);
-    e = errorOf(d / "slow");
+    e = refusalWhenWritten(d / "slow", set);
     EXPECT_NE(e.find("field 'rig.string.torsion_speed_ratio' must be a c_t / c from 1.2 to 15"), std::string::npos) << e;
     set.torsionSpeedRatio = 4.8;
     set.qTorsion = 5000.0;
-    writeMeasurementSet(d / "ringing", set, SF_FORMAT_FLOAT);
-    e = errorOf(d / "ringing");
+    e = refusalWhenWritten(d / "ringing", set);
     EXPECT_NE(e.find("field 'rig.string.q_torsion' must be a torsional Q from 3 to 1000"), std::string::npos) << e;
     fs::remove_all(d);
 }
@@ -412,8 +414,7 @@ TEST(MeasurementSet, MixedGesturesRoundTripAndAStrokeWithoutItsKindIsRefused)
     set.strokes[2].speed = 0.2;
     set.strokes[2].f0 = 1.3;
     set.strokes[2].tf = 0.015;
-    writeMeasurementSet(d / "set", set, SF_FORMAT_FLOAT);
-    const MeasurementSet back = readMeasurementSet(d / "set");
+    const MeasurementSet back = writtenAndRead(d / "set", set);
     ASSERT_EQ(back.strokes.size(), set.strokes.size());
     EXPECT_EQ(back.gesture, "mixed");
     EXPECT_EQ(back.strokes[0].gesture, "guettler");
@@ -431,12 +432,7 @@ TEST(MeasurementSet, MixedGesturesRoundTripAndAStrokeWithoutItsKindIsRefused)
 
     auto edited = [&](const std::string& name, const std::string& from, const std::string& to) {
         fs::copy(d / "set", d / name, fs::copy_options::recursive);
-        std::ifstream in(d / name / "manifest.json");
-        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        const auto at = text.find(from);
-        EXPECT_NE(at, std::string::npos) << from;
-        if (at != std::string::npos) text.replace(at, from.size(), to);
-        std::ofstream(d / name / "manifest.json") << text;
+        editManifest(d / name, from, to);
         return errorOf(d / name);
     };
     std::string e = edited("no-kind", "\"gesture\": \"exp_speed\"", "\"gestur\": \"exp_speed\"");
