@@ -310,6 +310,43 @@ std::string effectList(const std::vector<Finding>& list)
 }
 } // namespace
 
+namespace {
+// The data of maps.png: every stroke's place, role in the split, features as recorded and as the
+// baseline and the final model play it, and its disagreement part by part (uncapped parts are
+// not kept: the metric caps each at 1).
+void writeStrokeTable(const fs::path& file, const Diagnosis& d)
+{
+    std::map<std::string, const char*> role;
+    for (const auto& id : d.fitIds) role[id] = "fit";
+    for (const auto& id : d.validationIds) role[id] = "validation";
+    for (const auto& id : d.heldoutIds) role[id] = "test";
+    std::ofstream out(file);
+    out << "id,gesture,drive,bow_force_n,role";
+    for (const char* who : {"measured", "baseline", "final"})
+        out << ',' << who << "_first_slip_s," << who << "_force_before_slip_n," << who << "_jump_n," << who << "_transient_periods," << who << "_regime";
+    for (const char* who : {"baseline", "final"})
+        out << ',' << who << "_error," << who << "_first_slip_part," << who << "_force_before_slip_part," << who << "_jump_part," << who
+            << "_transient_part," << who << "_waveform_part";
+    out << '\n';
+    char buf[96];
+    auto number = [&](double x) {
+        std::snprintf(buf, sizeof buf, "%.9g", x);
+        return std::string(buf);
+    };
+    for (std::size_t i = 0; i < d.ids.size(); ++i) {
+        const auto r = role.find(d.ids[i]);
+        out << d.ids[i] << ',' << d.gestures[i] << ',' << number(d.drive[i]) << ',' << number(d.force[i]) << ',' << (r == role.end() ? "none" : r->second);
+        for (const auto* f : {&d.measured[i], &d.baselineSim[i], &d.finalSim[i]})
+            out << ',' << number(f->firstSlip) << ',' << number(f->forceBeforeSlip) << ',' << number(f->firstDrop) << ',' << f->transientPeriods << ','
+                << regimeName(f->regime);
+        for (const auto* e : {&d.baselineParts[i], &d.finalParts[i]})
+            out << ',' << number(e->total()) << ',' << number(e->firstSlip) << ',' << number(e->forceBeforeSlip) << ',' << number(e->jump) << ','
+                << number(e->transient) << ',' << number(e->waveform);
+        out << '\n';
+    }
+}
+} // namespace
+
 void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptions& o)
 {
     std::error_code ec;
@@ -392,7 +429,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         {"warnings", d.warnings}};
     std::ofstream(dir / "diagnosis.json") << doc.dump(1) << "\n";
     // The recorded split (reproducible from the seed), and the two-ended loops, beside it.
-    std::ofstream(dir / "split.json") << json{{"seed", o.seed}, {"fit", d.fitIds}, {"validation", d.validationIds}, {"test", d.heldoutIds}}.dump(1) << "\n";
+    std::ofstream(dir / "split.json") << json{{"seed", o.seed}, {"method", o.stratifiedSplit ? "stratified" : "random"}, {"fit", d.fitIds}, {"validation", d.validationIds}, {"test", d.heldoutIds}}.dump(1) << "\n";
     if (!d.loops.empty()) {
         json loops = json::array();
         for (const auto& l : d.loops)
@@ -431,6 +468,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         writePanelPng(dir / "maps.png", {measured, base, fin}, {"measured", "baseline: " + d.baseline.name(), "final: " + d.final.name()}, 3, dopt);
         overlays(dir / "overlays.png", d);
         jumps(dir / "jumps.png", d);
+        if (d.baselineParts.size() == d.ids.size() && d.finalParts.size() == d.ids.size()) writeStrokeTable(dir / "strokes.csv", d);
     }
 
     std::ofstream md(dir / "report.md");

@@ -19,6 +19,7 @@
 
 #include "rosin/dsp.h"
 #include "rosin/lab/Diagnose.h"
+#include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
 #include "rosin/lab/Resample.h"
 #include "rosin/lab/SynthData.h"
@@ -167,6 +168,72 @@ void check(const Case& k)
     if (!torsion) EXPECT_LE(scale->low, d.scale * diag::softeningAt(diag::kReadilyRollingZt) * (1.0 + 1e-12));
 }
 } // namespace
+
+// The split. Random: the whole set shuffled (as every diagnosis before 2026-12-05 dealt it).
+// Stratified: on a 12x12 Guettler grid every acceleration and every force gives the test and
+// the validation strokes 3 of its 12, within one, where a shuffle gives some row 6 or more on
+// most seeds; a mixed set gives each gesture its share. Both are fixed by the seed, disjoint and
+// complete, and a set too small for three sets is refused naming it.
+TEST(DiagnoseSplit, AStratifiedSplitGivesEveryRowAndColumnOfThePlaneItsShare)
+{
+    std::vector<StrokePlace> grid;
+    for (int a = 0; a < 12; ++a)
+        for (int f = 0; f < 12; ++f) grid.push_back({"guettler", 0.15 + 0.26 * a, 0.15 + 0.26 * f});
+    auto worstRow = [&](const std::vector<std::size_t>& ids, bool byForce) {
+        std::map<double, int> count;
+        for (const auto& p : grid) count[byForce ? p.force : p.drive] = 0;
+        for (auto i : ids) ++count[byForce ? grid[i].force : grid[i].drive];
+        int worst = 0;
+        for (const auto& [value, c] : count) worst = std::max(worst, std::abs(c - 3));
+        return worst;
+    };
+    int shuffledRowsOff = 0;
+    for (std::uint64_t seed = 1; seed <= 60; ++seed) {
+        DiagnoseOptions o;
+        o.seed = seed;
+        o.stratifiedSplit = true;
+        const StrokeSplit s = splitStrokes(grid, o, "grid");
+        ASSERT_EQ(s.test.size(), 36u);
+        ASSERT_EQ(s.validation.size(), 36u);
+        ASSERT_EQ(s.fit.size(), 72u);
+        std::set<std::size_t> all(s.fit.begin(), s.fit.end());
+        all.insert(s.validation.begin(), s.validation.end());
+        all.insert(s.test.begin(), s.test.end());
+        EXPECT_EQ(all.size(), 144u);
+        EXPECT_TRUE(std::is_sorted(s.validation.begin(), s.validation.end()));
+        for (bool byForce : {false, true}) {
+            EXPECT_LE(worstRow(s.test, byForce), 1) << "seed " << seed;
+            EXPECT_LE(worstRow(s.validation, byForce), 1) << "seed " << seed;
+        }
+        const StrokeSplit again = splitStrokes(grid, o, "grid");
+        EXPECT_EQ(again.validation, s.validation);
+        o.stratifiedSplit = false;
+        const StrokeSplit shuffled = splitStrokes(grid, o, "grid");
+        EXPECT_EQ(shuffled.validation.size(), 36u);
+        if (std::max(worstRow(shuffled.validation, false), worstRow(shuffled.validation, true)) >= 3) ++shuffledRowsOff;
+    }
+    EXPECT_GE(shuffledRowsOff, 30); // what the stratified split is for
+    DiagnoseOptions o;
+    o.stratifiedSplit = true;
+    const auto first = splitStrokes(grid, o, "grid").validation;
+    o.seed = 2;
+    EXPECT_NE(splitStrokes(grid, o, "grid").validation, first);
+    // A mixed set: 32 Guettler strokes and 16 rising-force ones; each gesture gives a quarter to validation.
+    std::vector<StrokePlace> mixed;
+    for (int k = 0; k < 32; ++k) mixed.push_back({"guettler", 0.2 * (k % 8), 0.3 * (k / 8)});
+    for (int k = 0; k < 16; ++k) mixed.push_back({"exp_force", 0.1 * k, 1.0});
+    const StrokeSplit m = splitStrokes(mixed, o, "mixed");
+    const auto risingInValidation = std::count_if(m.validation.begin(), m.validation.end(), [](std::size_t i) { return i >= 32; });
+    EXPECT_EQ(m.validation.size(), 12u);
+    EXPECT_NEAR(static_cast<double>(risingInValidation), 4.0, 1.0);
+    std::vector<StrokePlace> tiny(grid.begin(), grid.begin() + 13);
+    try {
+        splitStrokes(tiny, o, "tiny-set");
+        FAIL() << "a set of 13 strokes was split";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("tiny-set: too few strokes"), std::string::npos) << e.what();
+    }
+}
 
 // The rig unknowns' moves: the least-squares change of the parameters that takes up a change of
 // the signed residuals. On a linear problem it is exact; a direction the residuals do not feel

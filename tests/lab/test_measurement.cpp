@@ -8,8 +8,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "rosin/lab/Classifier.h"
+#include "rosin/lab/Diagnose.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
 #include "rosin/lab/Output.h"
@@ -502,7 +506,7 @@ TEST(DiagnoseCli, WritesTheDiagnosisAndRefusesABrokenSetWritingNothing)
     ASSERT_EQ(run(cli + " synth-data --grid 4 --seed 9 -q -o " + (d / "set").string()).first, 0);
     const auto ok = run(cli + " diagnose " + (d / "set").string() + " --max-evaluations 8 --shift-margin 0.25 -o " + (d / "out").string());
     ASSERT_EQ(ok.first, 0) << ok.second;
-    for (const char* f : {"diagnosis.json", "report.md", "maps.png", "overlays.png", "jumps.png", "split.json", "two_ended.json", "loops.png"})
+    for (const char* f : {"diagnosis.json", "report.md", "maps.png", "strokes.csv", "overlays.png", "jumps.png", "split.json", "two_ended.json", "loops.png"})
         EXPECT_TRUE(fs::exists(d / "out" / f)) << f;
     std::ifstream in(d / "out" / "diagnosis.json");
     const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -512,6 +516,50 @@ TEST(DiagnoseCli, WritesTheDiagnosisAndRefusesABrokenSetWritingNothing)
         EXPECT_NE(json.find(key), std::string::npos) << key;
     // the rules printed are the ones applied: the shift's margin as given
     EXPECT_NE(json.find("a rosin shift below the rate dependence by 25 %"), std::string::npos);
+    // strokes.csv, the data of maps.png: one row per stroke, its role as split.json has it, and
+    // its errors the ones the gain was measured with (mean over the test rows) and their parts'
+    // weighted sum.
+    const auto doc = nlohmann::json::parse(json);
+    const auto split = nlohmann::json::parse(std::ifstream(d / "out" / "split.json"));
+    std::ifstream table(d / "out" / "strokes.csv");
+    ASSERT_TRUE(table.good());
+    std::string line;
+    std::getline(table, line);
+    std::map<std::string, std::size_t> column;
+    {
+        std::stringstream header(line);
+        for (std::string name; std::getline(header, name, ',');) column[name] = column.size();
+    }
+    for (const char* name : {"id", "role", "drive", "bow_force_n", "measured_first_slip_s", "final_regime", "baseline_error", "final_error", "final_waveform_part"})
+        ASSERT_TRUE(column.count(name)) << name;
+    std::map<std::string, int> roles;
+    double baselineTest = 0, finalTest = 0;
+    int rows = 0;
+    while (std::getline(table, line)) {
+        std::vector<std::string> cell;
+        std::stringstream row(line);
+        for (std::string c; std::getline(row, c, ',');) cell.push_back(c);
+        ASSERT_EQ(cell.size(), column.size()) << line;
+        ++rows;
+        const std::string role = cell[column["role"]];
+        ++roles[role];
+        const auto& ids = split.at(role);
+        EXPECT_NE(std::find(ids.begin(), ids.end(), cell[column["id"]]), ids.end()) << line;
+        double weighted = 0;
+        const char* parts[] = {"first_slip", "force_before_slip", "jump", "transient", "waveform"};
+        for (int k = 0; k < 5; ++k) weighted += rosin::lab::ErrorParts::kWeights[k] * std::stod(cell[column[std::string("final_") + parts[k] + "_part"]]);
+        EXPECT_NEAR(weighted, std::stod(cell[column["final_error"]]), 1e-7) << line;
+        if (role == "test") {
+            baselineTest += std::stod(cell[column["baseline_error"]]) / 4.0;
+            finalTest += std::stod(cell[column["final_error"]]) / 4.0;
+        }
+    }
+    EXPECT_EQ(rows, 16);
+    EXPECT_EQ(roles["fit"], 8);
+    EXPECT_EQ(roles["validation"], 4);
+    EXPECT_EQ(roles["test"], 4);
+    EXPECT_NEAR(baselineTest, doc["gain"]["baseline"].get<double>(), 1e-6);
+    EXPECT_NEAR(finalTest, doc["gain"]["final"].get<double>(), 1e-6);
     // A broken set: refused, naming the file and field, and no output folder appears.
     fs::remove(d / "set" / "transients" / "a01_f01.wav");
     const auto bad = run(cli + " diagnose " + (d / "set").string() + " -o " + (d / "out2").string());

@@ -85,6 +85,12 @@ struct DiagnoseOptions {
     /// it carries r_A and the nuisances too, and its first search can stall where they stood
     /// (docs/diagnosis.md).
     bool restartContact = true;
+    /// How the strokes are dealt to fit, validation and test. Random: a shuffle of the whole set.
+    /// Stratified: every gesture, every drive and every bow force of the set gives each role about
+    /// its share (a model's misfit is often a whole row of the Guettler plane, such as the lowest
+    /// force, and how many of that row the validation strokes drew moved a marginal verdict with
+    /// the seed: docs/diagnosis-study.md).
+    bool stratifiedSplit = false;
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     /// The model's own error on rigs it does not describe (their thermal constants, an unnamed
     /// torsion): the standard deviation that a finding's parameter still misses the truth by
@@ -217,8 +223,25 @@ struct Diagnosis {
     std::vector<std::string> gestures; ///< guettler, exp_speed or exp_force
     std::vector<double> drive, force;  ///< place in the gesture's plane (Gesture::drive(), the final bow force)
     std::vector<StrokeFeatures> measured, baselineSim, finalSim;
+    /// Each stroke's disagreement with its recording under the baseline and the final model: the
+    /// per-stroke data of maps.png, written to strokes.csv.
+    std::vector<ErrorParts> baselineParts, finalParts;
     std::vector<std::vector<double>> measuredForce, baselineForce, finalForce; ///< first 12 periods
 };
+
+/// Where a stroke sits: its gesture and its place in that gesture's plane (Gesture::drive() and
+/// the bow force).
+struct StrokePlace {
+    std::string gesture;
+    double drive = 0, force = 0;
+};
+/// The fit, validation and test strokes (indices into `places`, each list sorted), drawn from the
+/// options' seed (DiagnoseOptions::stratifiedSplit says how); throws LabError naming `setName`
+/// when there are too few strokes for three sets.
+struct StrokeSplit {
+    std::vector<std::size_t> fit, validation, test;
+};
+StrokeSplit splitStrokes(const std::vector<StrokePlace>& places, const DiagnoseOptions& options, const std::string& setName);
 
 Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& options,
                    const std::function<void(const std::string&, double)>& progress = {});
