@@ -328,11 +328,7 @@ void writeStrokeTable(const fs::path& file, const Diagnosis& d)
         out << ',' << who << "_error," << who << "_first_slip_part," << who << "_force_before_slip_part," << who << "_jump_part," << who
             << "_transient_part," << who << "_waveform_part";
     out << '\n';
-    char buf[96];
-    auto number = [&](double x) {
-        std::snprintf(buf, sizeof buf, "%.9g", x);
-        return std::string(buf);
-    };
+    auto number = [](double x) { return fmt(x, "%.9g"); };
     for (std::size_t i = 0; i < d.ids.size(); ++i) {
         const auto r = role.find(d.ids[i]);
         out << d.ids[i] << ',' << d.gestures[i] << ',' << number(d.drive[i]) << ',' << number(d.force[i]) << ',' << (r == role.end() ? "none" : r->second);
