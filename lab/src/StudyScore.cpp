@@ -83,6 +83,9 @@ struct Scored {
     std::vector<std::string> standIns; ///< effects set aside beside a residual beyond the usual one (rule 6): not named
     double overFloor = 0;      ///< the final error over the set's noise-and-chaos floor
     std::string units;         ///< "V" or "N" as the diagnosis read the set ("" when it does not say)
+    /// how the diagnosis dealt the strokes into fit, validation and test (split.json's "method";
+    /// diagnoses from before the stratified split have no method and were all "random")
+    std::string splitMethod = "random";
 };
 
 std::string fmt(const char* f, double x)
@@ -197,6 +200,11 @@ Scored readScored(const fs::path& f)
                     s.calibrationNotWidened.insert(name);
                 }
             }
+    if (const fs::path split = f / "diagnosis" / "split.json"; fs::exists(split)) {
+        json j;
+        std::ifstream(split) >> j;
+        s.splitMethod = j.value("method", "random");
+    }
     s.baseline = d["gain"]["baseline"].get<double>();
     s.final = d["gain"]["final"].get<double>();
     s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
@@ -223,6 +231,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     json plan = readPlan(studies.front());
     std::map<std::uint64_t, std::string> seenSeeds; // set seed -> where it was first met
     std::pair<std::string, std::string> unitsSeen; // the first set's units (Scored::units) and where it was met
+    std::pair<std::string, std::string> splitSeen; // the first set's split method and where it was met
     std::string sources;
     std::vector<Scored> sets;
     for (const fs::path& study : studies) {
@@ -247,6 +256,12 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
                     throw LabError(f.string() + ": a set in " + s.units + " where " + unitsSeen.second + " is in " + unitsSeen.first +
                                    ": studies scored together must share the sensor's units");
             }
+            // A false-positive rate or a detection rate is a property of the whole procedure, and the
+            // split is part of it: two procedures scored together would describe neither.
+            if (splitSeen.first.empty()) splitSeen = {s.splitMethod, f.string()};
+            else if (s.splitMethod != splitSeen.first)
+                throw LabError(f.string() + "/diagnosis/split.json: method \"" + s.splitMethod + "\" where " + splitSeen.second +
+                               " has \"" + splitSeen.first + "\": studies scored together must split their strokes the same way");
             // The same set counted twice (one study pooled twice, or two folders of one seed) would
             // pass for a larger study.
             if (const auto [at, fresh] = seenSeeds.emplace(s.seed, f.string()); !fresh && s.seed != 0)
@@ -276,6 +291,8 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     json summary;
     md << "# Diagnosis study: " << sets.size() << " reference sets\n\n";
     if (pooled) md << "Scored together from " << studies.size() << " studies: " << sources << ".\n\n";
+    md << "Strokes split into fit, validation and test: " << (splitSeen.first == "stratified" ? "stratified over the Guettler plane" : "shuffled")
+       << " (split.json's method \"" << splitSeen.first << "\").\n";
     md << "Sets named exactly right (every hidden effect and nothing else): " << exact << " of " << sets.size() << ".\n";
     md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
     // What the models on the list could not explain, and how far above the sets' own floors.
@@ -343,6 +360,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         {"sets", residuals}, {"null_sets", nullResiduals}, {"beyond_usual", beyondUsual}, {"median_over_floor", overFloor[overFloor.size() / 2]}};
     summary["stand_ins"] = {{"sets", standInSets}, {"not_hidden", standInsNotHidden}, {"hidden", standInsHidden}};
     summary["sets"] = sets.size();
+    summary["split_method"] = splitSeen.first;
     summary["exact"] = exact;
     summary["null_sets"] = nNull;
     summary["null_false_positives"] = nullFp;

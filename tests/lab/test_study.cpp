@@ -871,6 +871,30 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     }
     writeSet(b, 0, truth(nothing, 21), withScale(residual(none, 9.25), "sensor scale (N per signal unit) from the pre-slip ramps"));
     EXPECT_NO_THROW(scoreStudies(out, {a, b}));
+    // The split is part of the procedure whose rates are scored: a study whose strokes were dealt
+    // over the plane is not pooled with a shuffled one. A diagnosis without a method (before the
+    // stratified split existed) was shuffled.
+    const auto writeSplit = [](const fs::path& folder, int index, const std::string& method) {
+        std::ofstream(setDir(folder, index) / "diagnosis" / "split.json") << json{{"seed", 1}, {"method", method}}.dump();
+    };
+    writeSplit(a, 0, "random");
+    EXPECT_NE(scoreStudies(out, {a, b}).find("Strokes split into fit, validation and test: shuffled"), std::string::npos);
+    writeSplit(b, 2, "stratified");
+    try {
+        scoreStudies(out, {a, b});
+        ADD_FAILURE() << "a stratified set was pooled with shuffled ones";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("must split their strokes the same way"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("split.json"), std::string::npos) << e.what();
+    }
+    for (int i : {0, 1}) writeSplit(a, i, "stratified");
+    for (int i : {0, 1}) writeSplit(b, i, "stratified");
+    EXPECT_NE(scoreStudies(out, {a, b}).find("Strokes split into fit, validation and test: stratified over the Guettler plane"), std::string::npos);
+    std::ifstream(out / "study.json") >> study;
+    EXPECT_EQ(study["summary"]["split_method"], "stratified");
+    for (const auto& folder : {a, b})
+        for (int i : {0, 1, 2})
+            if (fs::exists(setDir(folder, i))) fs::remove(setDir(folder, i) / "diagnosis" / "split.json");
     // One study scored on its own keeps its plain labels and gains no "pooled_from".
     scoreStudy(a);
     json alone;
