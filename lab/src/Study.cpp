@@ -163,6 +163,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         const MeasurementSet set = readMeasurementSet(here / "set");
         DiagnoseOptions d = o.diagnose;
         d.quiet = true;
+        if (o.splitPerSet) d.seed = perSetDiagnoseSeed(o.diagnose.seed, p.seed);
         const Diagnosis result = diagnose(set, d, [&](const std::string&, double x) { say("diagnosing", 0.5 + 0.5 * x); });
         const fs::path tmp = here / ".diagnosis.partial";
         writeDiagnosis(tmp, result, d);
@@ -170,6 +171,16 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         if (!o.keepSets && !kept) fs::remove_all(here / "set");
     }
     mpi.barrier();
+}
+
+std::uint64_t perSetDiagnoseSeed(std::uint64_t diagnoseSeed, std::uint64_t setSeed)
+{
+    // splitmix64's finaliser over the pair: neighbouring set seeds get unrelated splits, and the
+    // result stays under 2^53 so that split.json's number reads back exactly anywhere.
+    std::uint64_t z = diagnoseSeed * 0x9E3779B97F4A7C15ull + setSeed;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return (z ^ (z >> 31)) >> 11;
 }
 
 } // namespace rosin::lab

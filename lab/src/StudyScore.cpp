@@ -86,6 +86,7 @@ struct Scored {
     /// how the diagnosis dealt the strokes into fit, validation and test (split.json's "method";
     /// diagnoses from before the stratified split have no method and were all "random")
     std::string splitMethod = "random";
+    std::uint64_t splitSeed = 0; ///< split.json's seed (0 where the diagnosis wrote none)
 };
 
 std::string fmt(const char* f, double x)
@@ -204,6 +205,7 @@ Scored readScored(const fs::path& f)
         json j;
         std::ifstream(split) >> j;
         s.splitMethod = j.value("method", "random");
+        s.splitSeed = j.value("seed", std::uint64_t{0});
     }
     s.baseline = d["gain"]["baseline"].get<double>();
     s.final = d["gain"]["final"].get<double>();
@@ -291,8 +293,15 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     json summary;
     md << "# Diagnosis study: " << sets.size() << " reference sets\n\n";
     if (pooled) md << "Scored together from " << studies.size() << " studies: " << sources << ".\n\n";
+    // Sets of one grid diagnosed with one seed share one split: the rates below are then those
+    // of a single draw of the strokes that fit, validate and test (study --split-per-set).
+    std::set<std::uint64_t> splitSeeds;
+    for (const auto& s : sets) splitSeeds.insert(s.splitSeed);
     md << "Strokes split into fit, validation and test: " << (splitSeen.first == "stratified" ? "stratified over the Guettler plane" : "shuffled")
-       << " (split.json's method \"" << splitSeen.first << "\").\n";
+       << " (split.json's method \"" << splitSeen.first << "\"), "
+       << (splitSeeds.size() == 1 ? "one split for every set (seed " + std::to_string(*splitSeeds.begin()) + ")"
+                                  : std::to_string(splitSeeds.size()) + " split seeds over " + std::to_string(sets.size()) + " sets")
+       << ".\n";
     md << "Sets named exactly right (every hidden effect and nothing else): " << exact << " of " << sets.size() << ".\n";
     md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
     // What the models on the list could not explain, and how far above the sets' own floors.
@@ -361,6 +370,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     summary["stand_ins"] = {{"sets", standInSets}, {"not_hidden", standInsNotHidden}, {"hidden", standInsHidden}};
     summary["sets"] = sets.size();
     summary["split_method"] = splitSeen.first;
+    summary["split_seeds"] = splitSeeds.size();
     summary["exact"] = exact;
     summary["null_sets"] = nNull;
     summary["null_false_positives"] = nullFp;

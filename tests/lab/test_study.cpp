@@ -454,6 +454,51 @@ TEST(Study, GenerateOnlyKeepsTheSetsAndALaterRunDiagnosesThem)
     fs::remove_all(dir);
 }
 
+// Sets of one grid diagnosed with one seed share one split, so such a study measures a single
+// draw of fit, validation and test strokes; --split-per-set seeds each set's diagnosis from the
+// set's own seed, reproducibly, and the summary says which it was.
+TEST(Study, ASplitPerSetGivesEverySetItsOwnReproducibleSplit)
+{
+    EXPECT_EQ(perSetDiagnoseSeed(1, 2060), perSetDiagnoseSeed(1, 2060));
+    EXPECT_NE(perSetDiagnoseSeed(1, 2060), perSetDiagnoseSeed(1, 2061));
+    EXPECT_NE(perSetDiagnoseSeed(1, 2060), perSetDiagnoseSeed(2, 2060));
+    EXPECT_LT(perSetDiagnoseSeed(7, ~0ull), 1ull << 53) << "split.json's seed must read back exactly as a JSON number";
+
+    const fs::path dir = freshDir("split-per-set");
+    StudyOptions o;
+    o.sets = 2;
+    o.nulls = 2;
+    o.grid = 4;
+    o.seed = 13;
+    o.keepSets = true; // diagnosed twice below, simulated once
+    o.diagnose.maxEvaluations = 5;
+    o.diagnose.parameterBootstrap = 2;
+    o.diagnose.bootstrap = 200;
+    const auto splitOf = [&](int k) {
+        json j;
+        std::ifstream(setDir(dir, k) / "diagnosis" / "split.json") >> j;
+        return j;
+    };
+    const std::vector<StudySet> plan = planStudy(o);
+    o.splitPerSet = true;
+    runStudy(dir, o);
+    for (int k = 0; k < 2; ++k)
+        EXPECT_EQ(splitOf(k)["seed"].get<std::uint64_t>(), perSetDiagnoseSeed(1, plan[static_cast<std::size_t>(k)].seed)) << k;
+    EXPECT_NE(splitOf(0)["test"], splitOf(1)["test"]);
+    EXPECT_NE(scoreStudy(dir).find("shuffled (split.json's method \"random\"), 2 split seeds over 2 sets."), std::string::npos);
+
+    for (int k = 0; k < 2; ++k) fs::remove_all(setDir(dir, k) / "diagnosis");
+    o.splitPerSet = false;
+    runStudy(dir, o);
+    EXPECT_EQ(splitOf(0)["seed"], 1);
+    EXPECT_EQ(splitOf(0)["test"], splitOf(1)["test"]) << "one seed, one grid: one split";
+    EXPECT_NE(scoreStudy(dir).find("one split for every set (seed 1)."), std::string::npos);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    EXPECT_EQ(study["summary"]["split_seeds"], 1);
+    fs::remove_all(dir);
+}
+
 TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
 {
     const fs::path dir = freshDir("score");

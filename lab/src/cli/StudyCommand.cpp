@@ -53,6 +53,9 @@ struct StudyCommand {
             ->capture_default_str();
         cmd->add_option("--oversampling", options.oversampling, "Reference simulation rate / file rate")->check(CLI::Range(4, 32))->capture_default_str();
         cmd->add_option("--diagnose-seed", options.diagnose.seed, "Seed of each diagnosis's split and bootstraps")->capture_default_str();
+        cmd->add_flag("--split-per-set", options.splitPerSet,
+                      "Give every set its own split (and bootstraps), seeded from the set's seed and --diagnose-seed, so that the study "
+                      "samples which strokes fit, validate and test; without it every set of a grid shares one split");
         cmd->add_option("--rig-param", rigValues,
                         "Reference rig value NAME=VALUE fixed in every set instead of drawn (names: rosin synth-data --help), e.g. "
                         "inharmonicity=1e-3 for strongly stiff strings");

@@ -51,8 +51,17 @@ struct StudyOptions {
     std::vector<int> only;
     std::string hiding;
     DiagnoseOptions diagnose;
+    /// Each set's diagnosis split (and bootstraps) seeded from the set's own seed and
+    /// diagnose.seed, instead of every set sharing diagnose.seed: the sets of one grid then share
+    /// one split, so a study without it measures a single draw of which strokes fit, validate
+    /// and test, and its rates are conditional on that draw.
+    bool splitPerSet = false;
     bool quiet = false;
 };
+
+/// The diagnosis seed of a set under StudyOptions::splitPerSet: reproducible from the set's seed
+/// and the study's diagnosis seed, written to the set's split.json.
+std::uint64_t perSetDiagnoseSeed(std::uint64_t diagnoseSeed, std::uint64_t setSeed);
 
 /// One planned set: its hidden effects and the seed its rig and parameters are drawn from.
 struct StudySet {
