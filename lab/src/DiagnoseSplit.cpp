@@ -26,7 +26,7 @@ StrokeSplit splitStrokes(const std::vector<StrokePlace>& places, const DiagnoseO
     std::iota(shuffled.begin(), shuffled.end(), 0);
     std::shuffle(shuffled.begin(), shuffled.end(), rng);
     if (!o.stratifiedSplit) {
-        // As every diagnosis before the stratified split dealt them (kept so that those runs can be repeated).
+        // The default, and how every diagnosis before the stratified split dealt them.
         split.test.assign(shuffled.begin(), shuffled.begin() + static_cast<long>(nTest));
         split.validation.assign(shuffled.begin() + static_cast<long>(nTest), shuffled.begin() + static_cast<long>(nTest + nVal));
         split.fit.assign(shuffled.begin() + static_cast<long>(nTest + nVal), shuffled.end());

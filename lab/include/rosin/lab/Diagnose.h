@@ -89,9 +89,9 @@ struct DiagnoseOptions {
     /// Stratified: every gesture, every drive and every bow force of the set gives each role about
     /// its share. A model's misfit is often a whole row of the Guettler plane (such as the lowest
     /// force), and how much of that row validation drew moved a verdict's numbers with the split
-    /// seed; stratified, a round-1 candidate's validation fall moves about half as much. Off until
-    /// a paired fresh-seed verdict: its first one (seed 2060) named 4 fewer effects than the
-    /// shuffle had (docs/diagnosis-study.md, thirty-ninth session).
+    /// seed; stratified, a round-1 candidate's validation fall moves about half as much. Off: on
+    /// seed 2060, with one split for all sets or a split per set, it named fewer effects than the
+    /// shuffle, contacts above all (docs/diagnosis-study.md, fortieth session).
     bool stratifiedSplit = false;
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     /// The model's own error on rigs it does not describe (their thermal constants, an unnamed

@@ -52,9 +52,9 @@ struct StudyOptions {
     std::string hiding;
     DiagnoseOptions diagnose;
     /// Each set's diagnosis split (and bootstraps) seeded from the set's own seed and
-    /// diagnose.seed, instead of every set sharing diagnose.seed: the sets of one grid then share
-    /// one split, so a study without it measures a single draw of which strokes fit, validate
-    /// and test, and its rates are conditional on that draw.
+    /// diagnose.seed. Without it every set is diagnosed with diagnose.seed, so the sets of one
+    /// grid share one split: the study measures a single draw of which strokes fit, validate and
+    /// test, and its rates are conditional on that draw.
     bool splitPerSet = false;
     bool quiet = false;
 };
