@@ -121,6 +121,29 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         if ((o.only.empty() || std::find(o.only.begin(), o.only.end(), p.index) != o.only.end()) &&
             (o.hiding.empty() || std::find(p.effects.begin(), p.effects.end(), o.hiding) != p.effects.end()))
             picked.push_back(p);
+    // The split is part of what a study measures, so a resumed study may not change it either:
+    // sets already diagnosed are checked before any work, or a study would score two kinds of
+    // split (or one shared split and forty) as one.
+    const auto diagnoseSeedOf = [&](const StudySet& p) { return o.splitPerSet ? perSetDiagnoseSeed(o.diagnose.seed, p.seed) : o.diagnose.seed; };
+    const std::string method = o.diagnose.stratifiedSplit ? "stratified" : "random";
+    for (const StudySet& p : picked) {
+        char name[16];
+        std::snprintf(name, sizeof name, "%03d", p.index);
+        const fs::path split = dir / "sets" / name / "diagnosis" / "split.json";
+        if (!fs::exists(split)) continue;
+        json was;
+        try {
+            std::ifstream(split) >> was;
+        } catch (const json::exception& e) {
+            throw LabError(split.string() + ": unreadable (" + e.what() + ")");
+        }
+        const std::uint64_t seedWas = was.value("seed", std::uint64_t{0});
+        const std::string methodWas = was.value("method", std::string("random")); // older diagnoses only shuffled
+        if (seedWas != diagnoseSeedOf(p) || methodWas != method)
+            throw LabError(split.string() + ": this set was diagnosed with split seed " + std::to_string(seedWas) + " (method \"" + methodWas +
+                           "\") where this run would use " + std::to_string(diagnoseSeedOf(p)) + " (\"" + method +
+                           "\"); a resumed study keeps its --split-per-set, --stratified-split and --diagnose-seed: use a new folder, or remove the sets' diagnosis folders");
+    }
     std::size_t done = 0;
     for (const StudySet& p : picked) {
         ++done;
@@ -163,7 +186,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
         const MeasurementSet set = readMeasurementSet(here / "set");
         DiagnoseOptions d = o.diagnose;
         d.quiet = true;
-        if (o.splitPerSet) d.seed = perSetDiagnoseSeed(o.diagnose.seed, p.seed);
+        d.seed = diagnoseSeedOf(p);
         const Diagnosis result = diagnose(set, d, [&](const std::string&, double x) { say("diagnosing", 0.5 + 0.5 * x); });
         const fs::path tmp = here / ".diagnosis.partial";
         writeDiagnosis(tmp, result, d);

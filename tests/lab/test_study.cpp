@@ -496,6 +496,29 @@ TEST(Study, ASplitPerSetGivesEverySetItsOwnReproducibleSplit)
     json study;
     std::ifstream(dir / "study.json") >> study;
     EXPECT_EQ(study["summary"]["split_seeds"], 1);
+
+    // Resuming with another kind of split is refused before any set is touched, naming the file.
+    const auto refusal = [&](const StudyOptions& resumed) {
+        try {
+            runStudy(dir, resumed);
+        } catch (const LabError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    const auto before = fs::last_write_time(setDir(dir, 0) / "diagnosis" / "diagnosis.json");
+    o.splitPerSet = true;
+    const std::string perSet = refusal(o);
+    EXPECT_NE(perSet.find("000/diagnosis/split.json: this set was diagnosed with split seed 1 (method \"random\") where this run would use " +
+                          std::to_string(perSetDiagnoseSeed(1, plan[0].seed))),
+              std::string::npos)
+        << perSet;
+    o.splitPerSet = false;
+    o.diagnose.stratifiedSplit = true;
+    EXPECT_NE(refusal(o).find("where this run would use 1 (\"stratified\")"), std::string::npos);
+    o.diagnose.stratifiedSplit = false;
+    EXPECT_EQ(refusal(o), "") << "the same split resumes";
+    EXPECT_EQ(fs::last_write_time(setDir(dir, 0) / "diagnosis" / "diagnosis.json"), before);
     fs::remove_all(dir);
 }
 
