@@ -145,7 +145,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         say("calibration: tension and bow position", 0.0);
         Candidate cal = candidate("calibration", {"tension_scale", "beta_scale"}, {1.0, 1.0});
         cal.adds.clear(); // calibration is not an effect
-        const auto x = diag::fit(engine, current, cal, fitSet, cal.start, o.maxEvaluations, 0.2);
+        const auto x = diag::fit(engine, current, cal, fitSet, cal.start, o.maxEvaluations, 0.2, nullptr, true, o.secondStart);
         current = apply(current, cal, x);
     }
     d.baseline = current;
@@ -232,7 +232,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         // The same routine refits this round's winner without an earlier finding, so the two models
         // compared there were searched equally hard.
         auto search = [&](const EffectModel& base, const Candidate& c, double& fitError) {
-            std::vector<double> x = diag::fit(engine, base, c, fitSet, c.start, o.maxEvaluations, 0.2, &fitError);
+            std::vector<double> x = diag::fit(engine, base, c, fitSet, c.start, o.maxEvaluations, 0.2, &fitError, true, o.secondStart);
             // A rolling string changes the scale of every force the ramps read, so the parameters
             // named without it sit far from where they belong beside it, and the grid from there
             // misses the valley: search also from where round 1 left the torsion on the baseline,
@@ -356,7 +356,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 const Candidate c = withNuisances(*raw, current);
                 say("round " + std::to_string(round) + ": " + c.effect, 0.0);
                 double fitError = 0.0;
-                std::vector<double> x = diag::fit(engine, current, c, fitSet, c.start, 2 * o.maxEvaluations, 0.2, &fitError);
+                std::vector<double> x = diag::fit(engine, current, c, fitSet, c.start, 2 * o.maxEvaluations, 0.2, &fitError, true, o.secondStart);
                 searchAgain(current, c, startFromParts(c, alone->c, alone->x, other->c, other->x), 2 * o.maxEvaluations, 0.2, x, fitError);
                 pairs.push_back(evaluate(c, std::move(x), fitError, static_cast<std::uint64_t>(round * 100 + 50)));
                 const Tried& t = pairs.back();

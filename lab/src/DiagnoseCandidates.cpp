@@ -310,11 +310,25 @@ std::vector<std::pair<std::size_t, int>> gridDimensions(const Candidate& c)
     return dims;
 }
 
+std::vector<double> secondGridStart(const std::vector<std::pair<double, std::vector<double>>>& points, const std::vector<double>& best,
+                                    const std::vector<std::pair<std::size_t, int>>& dims)
+{
+    std::vector<double> from;
+    if (dims.size() < 2) return from; // along one parameter the grid's best point already brackets its valley
+    double lowest = 1e300;
+    for (const auto& [error, u] : points) {
+        // positions are (i + 0.5) / points, so two steps apart is 2 / points
+        const bool away = std::any_of(dims.begin(), dims.end(), [&](const auto& d) { return std::abs(u[d.first] - best[d.first]) * d.second > 1.5; });
+        if (away && error < lowest) lowest = error, from = u;
+    }
+    return from;
+}
+
 /// Fits the candidate's parameters on the given strokes. The error surface is rough (transients
 /// are chaotic), so a coarse grid over the bounds comes first and COBYLA refines from its best
 /// point on [0, 1]-scaled variables. `scan` = false skips the grid (warm starts).
 std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& asBuilt, const std::vector<std::size_t>& on,
-                        std::vector<double> start, int maxEval, double step, double* best, bool scan)
+                        std::vector<double> start, int maxEval, double step, double* best, bool scan, bool secondStart)
 {
     // Every fit searches tension and bow position within the set's own priors, wherever the
     // candidate was built.
@@ -327,12 +341,14 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
     const std::size_t n = c.names.size();
     std::vector<double> x(n);
     for (std::size_t k = 0; k < n; ++k) x[k] = (start[k] - c.lo[k]) / (c.hi[k] - c.lo[k]);
+    std::vector<double> secondFrom;
     if (scan) {
         const auto dims = gridDimensions(c);
         const int per = dims.empty() ? 7 : dims.front().second;
         int total = 1;
         for (const auto& d : dims) total *= d.second;
         double bestGrid = 1e300;
+        std::vector<std::pair<double, std::vector<double>>> seen;
         for (int g = 0; g < total; ++g) {
             std::vector<double> u = x, v(n);
             int rest = g;
@@ -342,9 +358,11 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
             }
             for (std::size_t k = 0; k < n; ++k) v[k] = c.lo[k] + u[k] * (c.hi[k] - c.lo[k]);
             const double e = mean(engine.errors(apply(base, c, v), on));
+            if (secondStart) seen.push_back({e, u});
             if (e < bestGrid) { bestGrid = e; x = u; }
         }
         step = 0.5 / per;
+        if (secondStart) secondFrom = secondGridStart(seen, x, dims);
     }
     struct Ctx {
         const Engine* engine;
@@ -370,6 +388,14 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
         opt.optimize(x, value);
     } catch (const std::exception&) {
         // COBYLA stops on its own criteria; the best point so far is in x either way
+    }
+    if (!secondFrom.empty()) {
+        double secondValue = 0.0;
+        try {
+            opt.optimize(secondFrom, secondValue);
+        } catch (const std::exception&) {
+        }
+        if (secondValue < value) x = std::move(secondFrom), value = secondValue;
     }
     if (best) *best = value;
     std::vector<double> v(n);

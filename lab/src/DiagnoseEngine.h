@@ -213,10 +213,17 @@ bool halvesConsistent(const Candidate& c, const std::vector<double>& low, const 
 std::vector<std::pair<std::size_t, int>> gridDimensions(const Candidate& c);
 /// The model base with the candidate's effects added and its parameters set to x.
 EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x);
-/// Fits the candidate's parameters on the strokes `on`: a coarse grid, then COBYLA from its best point.
+/// The grid point a second refinement starts from (DiagnoseOptions::secondStart): the lowest error
+/// among the points at least two grid steps from `best` along some dimension of `dims`; empty when
+/// the grid has one dimension or no such point. `points` pairs each grid point's error with its
+/// [0, 1]-scaled position.
+std::vector<double> secondGridStart(const std::vector<std::pair<double, std::vector<double>>>& points, const std::vector<double>& best,
+                                    const std::vector<std::pair<std::size_t, int>>& dims);
+/// Fits the candidate's parameters on the strokes `on`: a coarse grid, then COBYLA from its best point
+/// (and, with `secondStart`, from secondGridStart() too, keeping the better end).
 /// Tension and bow position are searched within boundsOf() the engine's set, whatever the candidate says.
 std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<std::size_t>& on,
-                        std::vector<double> start, int maxEval, double step, double* best = nullptr, bool scan = true);
+                        std::vector<double> start, int maxEval, double step, double* best = nullptr, bool scan = true, bool secondStart = false);
 /// Paired bootstrap of the mean of before - after: {mean, low, high} (95 %).
 std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after, int B, std::uint64_t seed);
 /// True when [lo, hi] reaches the parameter's no-effect value.

@@ -569,7 +569,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
     md << "\n## Method\n\nEvery recording is low-passed, cleaned of DC and mains hum, and its gesture start found by fitting the "
           "quasi-static ramp T·x_b/(βL) before the first slip; one scale (the median over strokes whose first slip comes after "
           "4 periods) converts the whole set to newtons. Fits use NLopt COBYLA after a coarse grid (the error surface is rough: "
-          "transients are chaotic). Parameter intervals: " << o.parameterBootstrap << " refits on bootstrap resamples of the fit strokes, "
+          "transients are chaotic)" << (o.secondStart ? ", refined from the grid's best point and from the best point two grid steps from it, the better end kept" : "") << ". Parameter intervals: " << o.parameterBootstrap << " refits on bootstrap resamples of the fit strokes, "
           "each from a fresh start, and a second from the local curvature (Gauss-Newton on the per-stroke errors, Eigen); the reported "
           "interval spans both and the refits on the low- and high-drive halves (a parameter that depends on which strokes it is fitted "
           "to carries model mismatch the resamples do not show), then adds in quadrature, side by side, the moves the rig unknowns "

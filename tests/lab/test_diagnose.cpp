@@ -451,6 +451,33 @@ TEST(DiagnoseParameters, TheEdgeAndDriveHalvesRulesIgnoreTheUnidentifiedH0)
     EXPECT_FALSE(diag::pinnedAtEdge(contact, y));
 }
 
+// Seed 2060's set 15 on the stratified split: the later-round contact's 5x5 grid over (load
+// exponent, r_A) had its best point at (1.03, 0.95), error 0.132, and the far end of the same
+// diagonal valley at (0.75, 1.25), 0.134; COBYLA from the first stopped at the contact's absence.
+// The second start is that far end, not the next-best point beside the first.
+TEST(DiagnoseParameters, TheSecondStartIsTheBestGridPointTwoStepsAway)
+{
+    using Dims = std::vector<std::pair<std::size_t, int>>;
+    const Dims dims{{0, 5}, {1, 5}};
+    const auto at = [](int i, int j) { return std::vector<double>{(i + 0.5) / 5, (j + 0.5) / 5, 0.4}; }; // a third, ungridded parameter
+    std::vector<std::pair<double, std::vector<double>>> grid;
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j) grid.push_back({0.5, at(i, j)});
+    const auto set = [&](int i, int j, double e) { grid[static_cast<std::size_t>(i * 5 + j)].first = e; };
+    set(4, 1, 0.1318); // exponent 1.03, r_A 0.95: the grid's best
+    set(3, 1, 0.1362); // beside it, second best of all
+    set(3, 2, 0.1400); // one step away along both
+    set(2, 2, 0.1338); // the valley's far end
+    set(0, 4, 0.1500);
+    EXPECT_EQ(diag::secondGridStart(grid, at(4, 1), dims), at(2, 2));
+    set(2, 2, 0.2000); // without that end, the best of what is two steps away
+    EXPECT_EQ(diag::secondGridStart(grid, at(4, 1), dims), at(0, 4));
+    // one gridded parameter: no second start (its best point already brackets the valley)
+    EXPECT_TRUE(diag::secondGridStart(grid, at(4, 1), Dims{{0, 7}}).empty());
+    // nothing two steps away on a 2x2 grid
+    EXPECT_TRUE(diag::secondGridStart({{0.1, {0.25, 0.25}}, {0.2, {0.75, 0.75}}}, {0.25, 0.25}, Dims{{0, 2}, {1, 2}}).empty());
+}
+
 // The coarse grid spends its points on what the data fix. h0 cancels out of the enhanced law, so
 // a grid along it repeats each error three times: round 1's 27 points over (r_A, h0, p) were nine
 // distinct ones (seed 2050's set 8 was fitted at p 0.307 for 0.162 from that grid).

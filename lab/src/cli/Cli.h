@@ -46,6 +46,10 @@ inline void addSearchFlags(CLI::App& cmd, DiagnoseOptions& o)
                  "A later round's Hertzian contact is searched again from where its first search ended, with a wider first step" +
                      byDefault(o.restartContact))
         ->capture_default_str();
+    cmd.add_flag("--second-start,!--no-second-start", o.secondStart,
+                 "Refine every gridded fit also from the best grid point two steps from the grid's best, and keep the better end" +
+                     byDefault(o.secondStart))
+        ->capture_default_str();
     cmd.add_flag("--stratified-split,!--random-split", o.stratifiedSplit,
                  "Deal fit, validation and test strokes so that every gesture, drive and bow force of the set gives each its share, "
                  "instead of a shuffle of the whole set" + byDefault(o.stratifiedSplit))
