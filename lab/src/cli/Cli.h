@@ -47,7 +47,7 @@ inline void addSearchFlags(CLI::App& cmd, DiagnoseOptions& o)
                      byDefault(o.restartContact))
         ->capture_default_str();
     cmd.add_flag("--second-start,!--no-second-start", o.secondStart,
-                 "Refine every gridded fit also from the best grid point two steps from the grid's best, and keep the better end" +
+                 "Refine every fit gridded over two or more parameters also from the best grid point two steps from the grid's best, and keep the better end" +
                      byDefault(o.secondStart))
         ->capture_default_str();
     cmd.add_flag("--stratified-split,!--random-split", o.stratifiedSplit,
