@@ -425,7 +425,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         {"warnings", d.warnings}};
     std::ofstream(dir / "diagnosis.json") << doc.dump(1) << "\n";
     // The recorded split (reproducible from the seed), and the two-ended loops, beside it.
-    std::ofstream(dir / "split.json") << json{{"seed", o.seed}, {"method", o.stratifiedSplit ? "stratified" : "random"}, {"fit", d.fitIds}, {"validation", d.validationIds}, {"test", d.heldoutIds}}.dump(1) << "\n";
+    std::ofstream(dir / "split.json") << json{{"seed", o.seed}, {"method", splitMethodName(o)}, {"fit", d.fitIds}, {"validation", d.validationIds}, {"test", d.heldoutIds}}.dump(1) << "\n";
     if (!d.loops.empty()) {
         json loops = json::array();
         for (const auto& l : d.loops)

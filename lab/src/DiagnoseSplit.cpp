@@ -13,6 +13,8 @@
 
 namespace rosin::lab {
 
+const char* splitMethodName(const DiagnoseOptions& o) { return o.stratifiedSplit ? "stratified" : "random"; }
+
 StrokeSplit splitStrokes(const std::vector<StrokePlace>& places, const DiagnoseOptions& o, const std::string& setName)
 {
     const std::size_t n = places.size();

@@ -63,17 +63,35 @@ std::vector<StudySet> planStudy(const StudyOptions& o)
     return plan;
 }
 
-json readPlan(const fs::path& dir)
+namespace {
+json readJsonFile(const fs::path& file)
 {
-    json plan;
-    if (fs::exists(dir / "plan.json")) {
-        try {
-            std::ifstream(dir / "plan.json") >> plan;
-        } catch (const json::exception& e) {
-            throw LabError((dir / "plan.json").string() + ": unreadable (" + e.what() + ")");
-        }
+    json j;
+    try {
+        std::ifstream(file) >> j;
+    } catch (const json::exception& e) {
+        throw LabError(file.string() + ": unreadable (" + e.what() + ")");
     }
-    return plan;
+    return j;
+}
+
+fs::path setFolder(const fs::path& dir, int index)
+{
+    char name[16];
+    std::snprintf(name, sizeof name, "%03d", index);
+    return dir / "sets" / name;
+}
+} // namespace
+
+json readPlan(const fs::path& dir) { return fs::exists(dir / "plan.json") ? readJsonFile(dir / "plan.json") : json(); }
+
+SplitRecord readSplitRecord(const fs::path& file)
+{
+    const json j = readJsonFile(file);
+    SplitRecord r;
+    r.seed = j.value("seed", r.seed);
+    r.method = j.value("method", r.method);
+    return r;
 }
 
 json populationOf(const json& plan)
@@ -125,22 +143,13 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     // sets already diagnosed are checked before any work, or a study would score two kinds of
     // split (or one shared split and forty) as one.
     const auto diagnoseSeedOf = [&](const StudySet& p) { return o.splitPerSet ? perSetDiagnoseSeed(o.diagnose.seed, p.seed) : o.diagnose.seed; };
-    const std::string method = o.diagnose.stratifiedSplit ? "stratified" : "random";
+    const std::string method = splitMethodName(o.diagnose);
     for (const StudySet& p : picked) {
-        char name[16];
-        std::snprintf(name, sizeof name, "%03d", p.index);
-        const fs::path split = dir / "sets" / name / "diagnosis" / "split.json";
+        const fs::path split = setFolder(dir, p.index) / "diagnosis" / "split.json";
         if (!fs::exists(split)) continue;
-        json was;
-        try {
-            std::ifstream(split) >> was;
-        } catch (const json::exception& e) {
-            throw LabError(split.string() + ": unreadable (" + e.what() + ")");
-        }
-        const std::uint64_t seedWas = was.value("seed", std::uint64_t{0});
-        const std::string methodWas = was.value("method", std::string("random")); // older diagnoses only shuffled
-        if (seedWas != diagnoseSeedOf(p) || methodWas != method)
-            throw LabError(split.string() + ": this set was diagnosed with split seed " + std::to_string(seedWas) + " (method \"" + methodWas +
+        const SplitRecord was = readSplitRecord(split);
+        if (was.seed != diagnoseSeedOf(p) || was.method != method)
+            throw LabError(split.string() + ": this set was diagnosed with split seed " + std::to_string(was.seed) + " (method \"" + was.method +
                            "\") where this run would use " + std::to_string(diagnoseSeedOf(p)) + " (\"" + method +
                            "\"); a resumed study keeps its --split-per-set, --stratified-split and --diagnose-seed: use a new folder, or remove the sets' diagnosis folders");
     }
@@ -148,9 +157,8 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     for (const StudySet& p : picked) {
         ++done;
         if (static_cast<int>((done - 1) % static_cast<std::size_t>(mpi.size())) != mpi.rank()) continue;
-        char name[16];
-        std::snprintf(name, sizeof name, "%03d", p.index);
-        const fs::path here = dir / "sets" / name;
+        const fs::path here = setFolder(dir, p.index);
+        const std::string name = here.filename().string();
         if (fs::exists(here / "diagnosis" / "diagnosis.json")) continue; // resumed study: already done
         // A set kept by an earlier run (--keep-sets, --generate-only) is diagnosed as it is: the
         // reference simulation is most of a set's time.
@@ -161,7 +169,7 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
             fs::create_directories(here);
         }
         auto say = [&](const std::string& what, double x) {
-            if (progress) progress("set " + std::string(name) + " (" + effectsLabel(p.effects) + "): " + what, (static_cast<double>(done - 1) + x) / static_cast<double>(picked.size()));
+            if (progress) progress("set " + name + " (" + effectsLabel(p.effects) + "): " + what, (static_cast<double>(done - 1) + x) / static_cast<double>(picked.size()));
         };
         SynthSpec spec;
         spec.generator = o.generator;

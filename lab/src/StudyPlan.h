@@ -2,13 +2,24 @@
 // scores it): read from its folder, and the part of it that names the population its sets come
 // from. Internal to lab/.
 #pragma once
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace rosin::lab {
 
 /// DIR/plan.json, or null when the folder has none; an unreadable one is refused naming the file.
 nlohmann::json readPlan(const std::filesystem::path& dir);
+
+/// What a set's diagnosis/split.json says of its split: the seed (0 where none was written) and
+/// the method (diagnoses from before the stratified split wrote none and were all "random").
+struct SplitRecord {
+    std::uint64_t seed = 0;
+    std::string method = "random";
+};
+/// Reads a split.json; an unreadable one is refused naming the file.
+SplitRecord readSplitRecord(const std::filesystem::path& file);
 
 /// What must match for studies to be scored as one: the strokes, the rig population and the
 /// effects' size ranges (a study of narrowed sizes would skew a pooled detection rate). The seed,

@@ -202,10 +202,9 @@ Scored readScored(const fs::path& f)
                 }
             }
     if (const fs::path split = f / "diagnosis" / "split.json"; fs::exists(split)) {
-        json j;
-        std::ifstream(split) >> j;
-        s.splitMethod = j.value("method", "random");
-        s.splitSeed = j.value("seed", std::uint64_t{0});
+        const SplitRecord r = readSplitRecord(split);
+        s.splitMethod = r.method;
+        s.splitSeed = r.seed;
     }
     s.baseline = d["gain"]["baseline"].get<double>();
     s.final = d["gain"]["final"].get<double>();

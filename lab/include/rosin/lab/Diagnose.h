@@ -251,6 +251,8 @@ struct StrokeSplit {
     std::vector<std::size_t> fit, validation, test;
 };
 StrokeSplit splitStrokes(const std::vector<StrokePlace>& places, const DiagnoseOptions& options, const std::string& setName);
+/// The options' split method as split.json records it: "stratified" or "random".
+const char* splitMethodName(const DiagnoseOptions& options);
 
 Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& options,
                    const std::function<void(const std::string&, double)>& progress = {});
