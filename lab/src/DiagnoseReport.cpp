@@ -421,6 +421,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         {"floor", {{"error", d.residual.floor}, {"final_over_floor", d.residual.ratio}, {"usual_ratio", d.residual.usual}, {"final_parts", d.residual.partError},
                    {"floor_parts", d.residual.partFloor}}},
         {"rules", d.rules},
+        {"search", searchSwitches(o)},
         {"trials", trials},
         {"warnings", d.warnings}};
     std::ofstream(dir / "diagnosis.json") << doc.dump(1) << "\n";

@@ -15,6 +15,11 @@ namespace rosin::lab {
 
 const char* splitMethodName(const DiagnoseOptions& o) { return o.stratifiedSplit ? "stratified" : "random"; }
 
+std::map<std::string, bool> searchSwitches(const DiagnoseOptions& o)
+{
+    return {{"pairs", o.tryPairs}, {"contact_restart", o.restartContact}, {"second_start", o.secondStart}};
+}
+
 StrokeSplit splitStrokes(const std::vector<StrokePlace>& places, const DiagnoseOptions& o, const std::string& setName)
 {
     const std::size_t n = places.size();

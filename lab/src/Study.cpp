@@ -94,6 +94,24 @@ SplitRecord readSplitRecord(const fs::path& file)
     return r;
 }
 
+std::map<std::string, bool> searchRecordOf(const json& diagnosis, const fs::path& file)
+{
+    if (!diagnosis.contains("search")) return {};
+    try {
+        return diagnosis["search"].get<std::map<std::string, bool>>();
+    } catch (const json::exception&) {
+        throw LabError(file.string() + ": \"search\" is not an object of on/off switches");
+    }
+}
+
+std::string describeSearch(const std::map<std::string, bool>& search)
+{
+    if (search.empty()) return "not recorded";
+    std::string text;
+    for (const auto& [name, on] : search) text += (text.empty() ? "" : ", ") + name + (on ? " on" : " off");
+    return text;
+}
+
 json populationOf(const json& plan)
 {
     json p;
@@ -144,6 +162,17 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     // split (or one shared split and forty) as one.
     const auto diagnoseSeedOf = [&](const StudySet& p) { return o.splitPerSet ? perSetDiagnoseSeed(o.diagnose.seed, p.seed) : o.diagnose.seed; };
     const std::string method = splitMethodName(o.diagnose);
+    // The search is part of the procedure too (--pairs, --contact-restart, --second-start);
+    // diagnoses from before diagnosis.json recorded it cannot be checked and are kept.
+    const std::map<std::string, bool> search = searchSwitches(o.diagnose);
+    for (const StudySet& p : picked) {
+        const fs::path diagnosis = setFolder(dir, p.index) / "diagnosis" / "diagnosis.json";
+        if (!fs::exists(diagnosis)) continue;
+        const std::map<std::string, bool> was = searchRecordOf(readJsonFile(diagnosis), diagnosis);
+        if (!was.empty() && was != search)
+            throw LabError(diagnosis.string() + ": this set was diagnosed with " + describeSearch(was) + " where this run would search with " +
+                           describeSearch(search) + "; a resumed study keeps its --pairs, --contact-restart and --second-start: use a new folder, or remove the sets' diagnosis folders");
+    }
     for (const StudySet& p : picked) {
         const fs::path split = setFolder(dir, p.index) / "diagnosis" / "split.json";
         if (!fs::exists(split)) continue;

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -20,6 +21,12 @@ struct SplitRecord {
 };
 /// Reads a split.json; an unreadable one is refused naming the file.
 SplitRecord readSplitRecord(const std::filesystem::path& file);
+
+/// A diagnosis.json's "search" switches (searchSwitches), empty where the diagnosis predates the
+/// record and so cannot be checked; a malformed record is refused naming `file`, where it was read.
+std::map<std::string, bool> searchRecordOf(const nlohmann::json& diagnosis, const std::filesystem::path& file);
+/// "pairs off, contact_restart on, second_start off", or "not recorded" for an empty record.
+std::string describeSearch(const std::map<std::string, bool>& search);
 
 /// What must match for studies to be scored as one: the strokes, the rig population and the
 /// effects' size ranges (a study of narrowed sizes would skew a pooled detection rate). The seed,

@@ -87,6 +87,7 @@ struct Scored {
     /// diagnoses from before the stratified split have no method and were all "random")
     std::string splitMethod = "random";
     std::uint64_t splitSeed = 0; ///< split.json's seed (0 where the diagnosis wrote none)
+    std::map<std::string, bool> search; ///< diagnosis.json's search switches (empty: not recorded)
 };
 
 std::string fmt(const char* f, double x)
@@ -206,6 +207,7 @@ Scored readScored(const fs::path& f)
         s.splitMethod = r.method;
         s.splitSeed = r.seed;
     }
+    s.search = searchRecordOf(d, f / "diagnosis" / "diagnosis.json");
     s.baseline = d["gain"]["baseline"].get<double>();
     s.final = d["gain"]["final"].get<double>();
     s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
@@ -233,6 +235,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     std::map<std::uint64_t, std::string> seenSeeds; // set seed -> where it was first met
     std::pair<std::string, std::string> unitsSeen; // the first set's units (Scored::units) and where it was met
     std::pair<std::string, std::string> splitSeen; // the first set's split method and where it was met
+    std::pair<std::map<std::string, bool>, std::string> searchSeen; // the first recorded search switches and where they were met
     std::string sources;
     std::vector<Scored> sets;
     for (const fs::path& study : studies) {
@@ -263,6 +266,13 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
             else if (s.splitMethod != splitSeen.first)
                 throw LabError(f.string() + "/diagnosis/split.json: method \"" + s.splitMethod + "\" where " + splitSeen.second +
                                " has \"" + splitSeen.first + "\": studies scored together must split their strokes the same way");
+            // So is the search; a diagnosis that did not record it is taken as it is.
+            if (!s.search.empty()) {
+                if (searchSeen.first.empty()) searchSeen = {s.search, f.string()};
+                else if (s.search != searchSeen.first)
+                    throw LabError(f.string() + "/diagnosis/diagnosis.json: search " + describeSearch(s.search) + " where " + searchSeen.second +
+                                   " has " + describeSearch(searchSeen.first) + ": studies scored together must search the same way");
+            }
             // The same set counted twice (one study pooled twice, or two folders of one seed) would
             // pass for a larger study.
             if (const auto [at, fresh] = seenSeeds.emplace(s.seed, f.string()); !fresh && s.seed != 0)
@@ -300,6 +310,10 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
        << " (split.json's method \"" << splitSeen.first << "\"), "
        << (splitSeeds.size() == 1 ? "one split for every set (seed " + std::to_string(*splitSeeds.begin()) + ")"
                                   : std::to_string(splitSeeds.size()) + " split seeds over " + std::to_string(sets.size()) + " sets")
+       << ".\n";
+    const auto unrecorded = std::count_if(sets.begin(), sets.end(), [](const Scored& s) { return s.search.empty(); });
+    md << "Search: " << describeSearch(searchSeen.first)
+       << (unrecorded > 0 && !searchSeen.first.empty() ? " (" + std::to_string(unrecorded) + " sets diagnosed before diagnosis.json recorded it)" : "")
        << ".\n";
     md << "Sets named exactly right (every hidden effect and nothing else): " << exact << " of " << sets.size() << ".\n";
     md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
@@ -370,6 +384,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     summary["sets"] = sets.size();
     summary["split_method"] = splitSeen.first;
     summary["split_seeds"] = splitSeeds.size();
+    if (!searchSeen.first.empty()) summary["search"] = searchSeen.first;
     summary["exact"] = exact;
     summary["null_sets"] = nNull;
     summary["null_false_positives"] = nullFp;

@@ -492,7 +492,9 @@ TEST(Study, ASplitPerSetGivesEverySetItsOwnReproducibleSplit)
     runStudy(dir, o);
     EXPECT_EQ(splitOf(0)["seed"], 1);
     EXPECT_EQ(splitOf(0)["test"], splitOf(1)["test"]) << "one seed, one grid: one split";
-    EXPECT_NE(scoreStudy(dir).find("one split for every set (seed 1)."), std::string::npos);
+    const std::string oneSplit = scoreStudy(dir);
+    EXPECT_NE(oneSplit.find("one split for every set (seed 1)."), std::string::npos);
+    EXPECT_NE(oneSplit.find("Search: contact_restart on, pairs off, second_start off.\n"), std::string::npos) << "diagnosis.json records the search";
     json study;
     std::ifstream(dir / "study.json") >> study;
     EXPECT_EQ(study["summary"]["split_seeds"], 1);
@@ -518,6 +520,17 @@ TEST(Study, ASplitPerSetGivesEverySetItsOwnReproducibleSplit)
     EXPECT_NE(refusal(o).find("where this run would use 1 (\"stratified\")"), std::string::npos);
     o.diagnose.stratifiedSplit = false;
     EXPECT_EQ(refusal(o), "") << "the same split resumes";
+    // So is another search, named by the set's diagnosis.json.
+    o.diagnose.secondStart = true;
+    const std::string otherSearch = refusal(o);
+    EXPECT_NE(otherSearch.find("000/diagnosis/diagnosis.json: this set was diagnosed with contact_restart on, pairs off, second_start off "
+                               "where this run would search with contact_restart on, pairs off, second_start on"),
+              std::string::npos)
+        << otherSearch;
+    o.diagnose.secondStart = false;
+    o.diagnose.tryPairs = true;
+    EXPECT_NE(refusal(o).find("pairs on"), std::string::npos);
+    o.diagnose.tryPairs = false;
     EXPECT_EQ(fs::last_write_time(setDir(dir, 0) / "diagnosis" / "diagnosis.json"), before);
     fs::remove_all(dir);
 }
@@ -963,6 +976,28 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     for (const auto& folder : {a, b})
         for (int i : {0, 1, 2})
             if (fs::exists(setDir(folder, i))) fs::remove(setDir(folder, i) / "diagnosis" / "split.json");
+    // So is the search, where diagnosis.json records it (older diagnoses did not, and are taken as they are).
+    const auto writeSearch = [](const fs::path& folder, int index, bool secondStart) {
+        const fs::path file = setDir(folder, index) / "diagnosis" / "diagnosis.json";
+        json d;
+        std::ifstream(file) >> d;
+        d["search"] = {{"pairs", false}, {"contact_restart", true}, {"second_start", secondStart}};
+        std::ofstream(file) << d.dump();
+    };
+    writeSearch(a, 0, true);
+    EXPECT_NE(scoreStudies(out, {a, b}).find("Search: contact_restart on, pairs off, second_start on ("), std::string::npos);
+    writeSearch(b, 0, false);
+    try {
+        scoreStudies(out, {a, b});
+        ADD_FAILURE() << "a study searched with a second start was pooled with one without";
+    } catch (const LabError& e) {
+        EXPECT_NE(std::string(e.what()).find("/diagnosis/diagnosis.json: search contact_restart on, pairs off, second_start off where "), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("must search the same way"), std::string::npos) << e.what();
+    }
+    writeSearch(b, 0, true);
+    scoreStudies(out, {a, b});
+    std::ifstream(out / "study.json") >> study;
+    EXPECT_EQ(study["summary"]["search"]["second_start"], true);
     // One study scored on its own keeps its plain labels and gains no "pooled_from".
     scoreStudy(a);
     json alone;

@@ -253,6 +253,9 @@ struct StrokeSplit {
 StrokeSplit splitStrokes(const std::vector<StrokePlace>& places, const DiagnoseOptions& options, const std::string& setName);
 /// The options' split method as split.json records it: "stratified" or "random".
 const char* splitMethodName(const DiagnoseOptions& options);
+/// The options' search switches as diagnosis.json's "search" records them (pairs,
+/// contact_restart, second_start): a study resumes and pools only diagnoses that searched alike.
+std::map<std::string, bool> searchSwitches(const DiagnoseOptions& options);
 
 Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& options,
                    const std::function<void(const std::string&, double)>& progress = {});
