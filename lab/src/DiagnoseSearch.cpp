@@ -54,6 +54,17 @@ std::vector<double> secondGridStart(const std::vector<std::pair<double, std::vec
     return from;
 }
 
+namespace {
+/// A point of COBYLA's [0, 1]-scaled search as the candidate's parameters (held at the bounds
+/// where its steps stray outside).
+std::vector<double> physical(const Candidate& c, const std::vector<double>& u)
+{
+    std::vector<double> v(u.size());
+    for (std::size_t k = 0; k < u.size(); ++k) v[k] = c.lo[k] + std::clamp(u[k], 0.0, 1.0) * (c.hi[k] - c.lo[k]);
+    return v;
+}
+} // namespace
+
 /// Fits the candidate's parameters on the given strokes. The error surface is rough (transients
 /// are chaotic), so a coarse grid over the bounds comes first and COBYLA refines from its best
 /// point on [0, 1]-scaled variables. `scan` = false skips the grid (warm starts).
@@ -86,6 +97,7 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
                 u[k] = (rest % points + 0.5) / points;
                 rest /= points;
             }
+            // not clamped: a start outside the bounds keeps its place in every grid point
             for (std::size_t k = 0; k < n; ++k) v[k] = c.lo[k] + u[k] * (c.hi[k] - c.lo[k]);
             const double e = mean(engine.errors(apply(base, c, v), on));
             if (secondStart) seen.push_back({e, u});
@@ -102,9 +114,7 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
     } ctx{&engine, &base, &c, &on};
     auto objective = [](const std::vector<double>& u, std::vector<double>&, void* data) {
         const Ctx& k = *static_cast<Ctx*>(data);
-        std::vector<double> v(u.size());
-        for (std::size_t i = 0; i < u.size(); ++i) v[i] = k.c->lo[i] + std::clamp(u[i], 0.0, 1.0) * (k.c->hi[i] - k.c->lo[i]);
-        return mean(k.engine->errors(apply(*k.base, *k.c, v), *k.on));
+        return mean(k.engine->errors(apply(*k.base, *k.c, physical(*k.c, u)), *k.on));
     };
     nlopt::opt opt(nlopt::LN_COBYLA, static_cast<unsigned>(n));
     opt.set_lower_bounds(std::vector<double>(n, 0.0));
@@ -128,9 +138,7 @@ std::vector<double> fit(const Engine& engine, const EffectModel& base, const Can
         if (secondValue < value) x = std::move(secondFrom), value = secondValue;
     }
     if (best) *best = value;
-    std::vector<double> v(n);
-    for (std::size_t k = 0; k < n; ++k) v[k] = c.lo[k] + std::clamp(x[k], 0.0, 1.0) * (c.hi[k] - c.lo[k]);
-    return v;
+    return physical(c, x);
 }
 
 /// Paired bootstrap of the mean of before - after: returns {mean, low, high} (95 %).

@@ -166,21 +166,20 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
     // diagnoses from before diagnosis.json recorded it cannot be checked and are kept.
     const std::map<std::string, bool> search = searchSwitches(o.diagnose);
     for (const StudySet& p : picked) {
-        const fs::path diagnosis = setFolder(dir, p.index) / "diagnosis" / "diagnosis.json";
-        if (!fs::exists(diagnosis)) continue;
-        const std::map<std::string, bool> was = searchRecordOf(readJsonFile(diagnosis), diagnosis);
-        if (!was.empty() && was != search)
-            throw LabError(diagnosis.string() + ": this set was diagnosed with " + describeSearch(was) + " where this run would search with " +
-                           describeSearch(search) + "; a resumed study keeps its --pairs, --contact-restart and --second-start: use a new folder, or remove the sets' diagnosis folders");
-    }
-    for (const StudySet& p : picked) {
-        const fs::path split = setFolder(dir, p.index) / "diagnosis" / "split.json";
-        if (!fs::exists(split)) continue;
-        const SplitRecord was = readSplitRecord(split);
-        if (was.seed != diagnoseSeedOf(p) || was.method != method)
-            throw LabError(split.string() + ": this set was diagnosed with split seed " + std::to_string(was.seed) + " (method \"" + was.method +
-                           "\") where this run would use " + std::to_string(diagnoseSeedOf(p)) + " (\"" + method +
-                           "\"); a resumed study keeps its --split-per-set, --stratified-split and --diagnose-seed: use a new folder, or remove the sets' diagnosis folders");
+        const fs::path diagnosed = setFolder(dir, p.index) / "diagnosis";
+        if (const fs::path split = diagnosed / "split.json"; fs::exists(split)) {
+            const SplitRecord was = readSplitRecord(split);
+            if (was.seed != diagnoseSeedOf(p) || was.method != method)
+                throw LabError(split.string() + ": this set was diagnosed with split seed " + std::to_string(was.seed) + " (method \"" + was.method +
+                               "\") where this run would use " + std::to_string(diagnoseSeedOf(p)) + " (\"" + method +
+                               "\"); a resumed study keeps its --split-per-set, --stratified-split and --diagnose-seed: use a new folder, or remove the sets' diagnosis folders");
+        }
+        if (const fs::path diagnosis = diagnosed / "diagnosis.json"; fs::exists(diagnosis)) {
+            const std::map<std::string, bool> was = searchRecordOf(readJsonFile(diagnosis), diagnosis);
+            if (!was.empty() && was != search)
+                throw LabError(diagnosis.string() + ": this set was diagnosed with " + describeSearch(was) + " where this run would search with " +
+                               describeSearch(search) + "; a resumed study keeps its --pairs, --contact-restart and --second-start: use a new folder, or remove the sets' diagnosis folders");
+        }
     }
     std::size_t done = 0;
     for (const StudySet& p : picked) {

@@ -25,7 +25,8 @@ SplitRecord readSplitRecord(const std::filesystem::path& file);
 /// A diagnosis.json's "search" switches (searchSwitches), empty where the diagnosis predates the
 /// record and so cannot be checked; a malformed record is refused naming `file`, where it was read.
 std::map<std::string, bool> searchRecordOf(const nlohmann::json& diagnosis, const std::filesystem::path& file);
-/// "pairs off, contact_restart on, second_start off", or "not recorded" for an empty record.
+/// "contact_restart on, pairs off, second_start off" (the switches in name order), or "not
+/// recorded" for an empty record.
 std::string describeSearch(const std::map<std::string, bool>& search);
 
 /// What must match for studies to be scored as one: the strokes, the rig population and the

@@ -39,18 +39,24 @@ fs::path setDir(const fs::path& dir, int index)
     return dir / "sets" / name;
 }
 
+/// Why pooling `studies` into `out` was refused ("pooled" when it was not).
+std::string poolRefusal(const fs::path& out, const std::vector<fs::path>& studies)
+{
+    try {
+        scoreStudies(out, studies);
+    } catch (const LabError& e) {
+        return e.what();
+    }
+    return "pooled";
+}
+
 /// Pools `study` with an empty 3x3 study of the whole population (seed `seed`, written into
 /// `whole`) into `out`, and returns why that was refused ("pooled" when it was not).
 std::string poolWithADrawnStudy(const fs::path& study, const fs::path& whole, const fs::path& out, int seed)
 {
     std::ofstream(whole / "plan.json") << json{{"grid", 3}, {"seed", seed}, {"sets", json::array()}}.dump();
     fs::create_directories(whole / "sets");
-    try {
-        scoreStudies(out, {study, whole});
-    } catch (const LabError& e) {
-        return e.what();
-    }
-    return "pooled";
+    return poolRefusal(out, {study, whole});
 }
 
 /// A 3x3 study of `sets` sets (`nulls` of them null) from `seed` that only makes its sets.
@@ -929,12 +935,8 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     EXPECT_THROW(scoreStudies(out, {a, a}), LabError);
     // Different strokes per set are a different population.
     std::ofstream(b / "plan.json") << json{{"grid", 8}, {"seed", 2}, {"sets", json::array()}}.dump();
-    try {
-        scoreStudies(out, {a, b});
-        ADD_FAILURE() << "studies of grids 12 and 8 were pooled";
-    } catch (const LabError& e) {
-        EXPECT_NE(std::string(e.what()).find("must share the grid"), std::string::npos) << e.what();
-    }
+    const std::string grids = poolRefusal(out, {a, b});
+    EXPECT_NE(grids.find("must share the grid"), std::string::npos) << "studies of grids 12 and 8: " << grids;
     // A newton study whose plan.json does not say so (older ones did not) is still told apart
     // by its diagnoses' sensor scale.
     std::ofstream(b / "plan.json") << json{{"grid", 12}, {"seed", 2}, {"sets", json::array()}}.dump();
@@ -944,12 +946,8 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     };
     writeSet(a, 0, truth(nothing, 11), withScale(residual(none, 6.5), "sensor scale (N per signal unit) from the pre-slip ramps"));
     writeSet(b, 0, truth(nothing, 21), withScale(residual(none, 9.25), "sensor scale: the set is calibrated in N"));
-    try {
-        scoreStudies(out, {a, b});
-        ADD_FAILURE() << "a volt study and a newton study were pooled";
-    } catch (const LabError& e) {
-        EXPECT_NE(std::string(e.what()).find("must share the sensor's units"), std::string::npos) << e.what();
-    }
+    const std::string units = poolRefusal(out, {a, b});
+    EXPECT_NE(units.find("must share the sensor's units"), std::string::npos) << "a volt study and a newton study: " << units;
     writeSet(b, 0, truth(nothing, 21), withScale(residual(none, 9.25), "sensor scale (N per signal unit) from the pre-slip ramps"));
     EXPECT_NO_THROW(scoreStudies(out, {a, b}));
     // The split is part of the procedure whose rates are scored: a study whose strokes were dealt
@@ -961,13 +959,9 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     writeSplit(a, 0, "random");
     EXPECT_NE(scoreStudies(out, {a, b}).find("Strokes split into fit, validation and test: shuffled"), std::string::npos);
     writeSplit(b, 2, "stratified");
-    try {
-        scoreStudies(out, {a, b});
-        ADD_FAILURE() << "a stratified set was pooled with shuffled ones";
-    } catch (const LabError& e) {
-        EXPECT_NE(std::string(e.what()).find("must split their strokes the same way"), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("split.json"), std::string::npos) << e.what();
-    }
+    const std::string splits = poolRefusal(out, {a, b});
+    EXPECT_NE(splits.find("must split their strokes the same way"), std::string::npos) << "a stratified set among shuffled ones: " << splits;
+    EXPECT_NE(splits.find("split.json"), std::string::npos) << splits;
     for (int i : {0, 1}) writeSplit(a, i, "stratified");
     for (int i : {0, 1}) writeSplit(b, i, "stratified");
     EXPECT_NE(scoreStudies(out, {a, b}).find("Strokes split into fit, validation and test: stratified over the Guettler plane"), std::string::npos);
@@ -987,13 +981,10 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     writeSearch(a, 0, true);
     EXPECT_NE(scoreStudies(out, {a, b}).find("Search: contact_restart on, pairs off, second_start on ("), std::string::npos);
     writeSearch(b, 0, false);
-    try {
-        scoreStudies(out, {a, b});
-        ADD_FAILURE() << "a study searched with a second start was pooled with one without";
-    } catch (const LabError& e) {
-        EXPECT_NE(std::string(e.what()).find("/diagnosis/diagnosis.json: search contact_restart on, pairs off, second_start off where "), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("must search the same way"), std::string::npos) << e.what();
-    }
+    const std::string searches = poolRefusal(out, {a, b});
+    EXPECT_NE(searches.find("/diagnosis/diagnosis.json: search contact_restart on, pairs off, second_start off where "), std::string::npos)
+        << "a study searched with a second start and one without: " << searches;
+    EXPECT_NE(searches.find("must search the same way"), std::string::npos) << searches;
     writeSearch(b, 0, true);
     scoreStudies(out, {a, b});
     std::ifstream(out / "study.json") >> study;
