@@ -84,6 +84,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
     auto say = [&](const std::string& what, double x) {
         if (progress) progress(what, x);
     };
+    checkMetricWeights(o.metricWeights, "metric weights");
     Diagnosis d;
     d.setName = set.folder.string();
     d.warnings = set.warnings;
@@ -122,7 +123,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         d.warnings.push_back(set.steady.empty() ? "no steady_sliding.csv: the reference SW00 curve is assumed for this rosin"
                                                 : "steady_sliding.csv has fewer than 5 rows: the reference SW00 curve is assumed");
     }
-    Engine engine(strokes, info, o.simRate, steady, set.units == "V");
+    Engine engine(strokes, info, o.simRate, steady, set.units == "V", o.metricWeights);
     EffectModel current;
     {
         // Which string constants the model plays (Engine::config decides): what the lab measured,
@@ -533,8 +534,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         d.measured[i] = strokes[i].feat;
         d.baselineSim[i] = engine.simulate(d.baseline, i, &d.baselineForce[i]);
         d.finalSim[i] = engine.simulate(d.final, i, &d.finalForce[i]);
-        d.baselineParts[i] = compare(strokes[i].feat, d.baselineSim[i], strokes[i].gesture, info);
-        d.finalParts[i] = compare(strokes[i].feat, d.finalSim[i], strokes[i].gesture, info);
+        d.baselineParts[i] = compare(strokes[i].feat, d.baselineSim[i], strokes[i].gesture, info, o.metricWeights);
+        d.finalParts[i] = compare(strokes[i].feat, d.finalSim[i], strokes[i].gesture, info, o.metricWeights);
         d.measuredForce[i].assign(strokes[i].force.begin(), strokes[i].force.begin() + static_cast<long>(std::min(strokes[i].force.size(), d.baselineForce[i].size())));
     });
     // 5. The ramps' scale assumed a string that does not roll. Every fit compared a rolling model

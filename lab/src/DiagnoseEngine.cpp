@@ -102,11 +102,16 @@ std::array<double, 4> scaledDifferences(const StrokeFeatures& m, const StrokeFea
 }
 } // namespace
 
-ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info)
+ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info,
+                   const std::array<double, 5>& weights)
 {
     ErrorParts e;
+    e.weights = weights;
     if (m.firstSlip < 0 && s.firstSlip < 0) return e;
-    if (m.firstSlip < 0 || s.firstSlip < 0) return {1, 1, 1, 1, 1};
+    if (m.firstSlip < 0 || s.firstSlip < 0) {
+        e.firstSlip = e.forceBeforeSlip = e.jump = e.transient = e.waveform = 1;
+        return e;
+    }
     const auto d = scaledDifferences(m, s, g);
     e.firstSlip = std::min(1.0, std::abs(d[0]));
     e.forceBeforeSlip = std::min(1.0, std::abs(d[1]));
@@ -122,11 +127,11 @@ ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gestu
     return e;
 }
 
-std::array<double, 4> signedParts(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g)
+std::array<double, 4> signedParts(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const std::array<double, 5>& weights)
 {
     if (m.firstSlip < 0 || s.firstSlip < 0) return {0, 0, 0, 0};
     auto d = scaledDifferences(m, s, g);
-    for (std::size_t k = 0; k < d.size(); ++k) d[k] *= ErrorParts::kWeights[k];
+    for (std::size_t k = 0; k < d.size(); ++k) d[k] *= weights[k];
     return d;
 }
 
@@ -205,8 +210,8 @@ double Engine::rampSoftening(const EffectModel& m, const dsp::BowedStringConfig&
 }
 
 Engine::Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady,
-               bool scaleFromRamps)
-    : strokes_(strokes), info_(info), fs_(fs), steady_(steady), scaleFromRamps_(scaleFromRamps), noise_(strokes.size())
+               bool scaleFromRamps, const std::array<double, 5>& metricWeights)
+    : strokes_(strokes), info_(info), fs_(fs), steady_(steady), scaleFromRamps_(scaleFromRamps), weights_(metricWeights), noise_(strokes.size())
 {
     tbb::parallel_for(std::size_t(0), strokes.size(), [&](std::size_t i) {
         if (strokes[i].noise > 0.0) noise_[i] = strokeNoise(i, strokes[i].force.size(), strokes[i].noise, 0);
@@ -269,7 +274,7 @@ std::vector<ErrorParts> Engine::errors(const EffectModel& m, const std::vector<s
     std::vector<ErrorParts> once(strokes.size());
     tbb::parallel_for(std::size_t(0), strokes.size(), [&](std::size_t k) {
         const std::size_t i = strokes[k];
-        once[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].gesture, info_);
+        once[k] = compare(strokes_[i].feat, simulate(m, i), strokes_[i].gesture, info_, weights_);
     });
     std::vector<ErrorParts> e(which.size());
     for (std::size_t k = 0; k < which.size(); ++k) e[k] = once[slot(strokes, which[k])];
@@ -282,7 +287,7 @@ Eigen::VectorXd Engine::signedResiduals(const EffectModel& m, const std::vector<
     std::vector<std::array<double, 4>> once(strokes.size());
     tbb::parallel_for(std::size_t(0), strokes.size(), [&](std::size_t k) {
         const std::size_t i = strokes[k];
-        once[k] = signedParts(strokes_[i].feat, simulate(m, i), strokes_[i].gesture);
+        once[k] = signedParts(strokes_[i].feat, simulate(m, i), strokes_[i].gesture, weights_);
     });
     Eigen::VectorXd r(static_cast<Eigen::Index>(4 * which.size()));
     for (std::size_t k = 0; k < which.size(); ++k)

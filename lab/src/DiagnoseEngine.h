@@ -69,11 +69,14 @@ double whiteNoiseOfRests(const std::vector<double>& differences, double fs);
 double slipFloorOf(std::vector<double> differences);
 /// Per-part disagreement of simulated features s with measured m, for a stroke of gesture g: the
 /// waveform is measured against the flyback the bow speed at the measured first slip would give.
-ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info);
+/// The parts carry `weights` (DiagnoseOptions::metricWeights) into their total().
+ErrorParts compare(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g, const StringInfo& info,
+                   const std::array<double, 5>& weights = ErrorParts::kWeights);
 double mean(const std::vector<ErrorParts>& e);
 /// The metric's first four parts with their signs (simulated - measured, scaled and weighted as
 /// in the metric, not capped): what a linearised fit can take up. Zero where a stroke has no slip.
-std::array<double, 4> signedParts(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g);
+std::array<double, 4> signedParts(const StrokeFeatures& m, const StrokeFeatures& s, const Gesture& g,
+                                  const std::array<double, 5>& weights = ErrorParts::kWeights);
 inline double median(std::vector<double> v)
 {
     if (v.empty()) return 0.0;
@@ -312,7 +315,7 @@ public:
     /// The strokes must keep their length and noise level while the engine lives. `scaleFromRamps`:
     /// the recordings' scale was taken from their pre-slip ramps assuming a string that does not roll.
     Engine(std::vector<Prepared>& strokes, const StringInfo& info, double fs, std::optional<dsp::SteadyCurve> steady,
-           bool scaleFromRamps = false);
+           bool scaleFromRamps = false, const std::array<double, 5>& metricWeights = ErrorParts::kWeights);
 
     /// The voice of model m: its effects, the set's steady-sliding curve and the nuisances.
     dsp::BowedStringConfig config(const EffectModel& m) const;
@@ -336,6 +339,7 @@ public:
     Eigen::VectorXd signedResiduals(const EffectModel& m, const std::vector<std::size_t>& which) const;
     long long simulations() const { return simulations_.load(); }
     const StringInfo& info() const { return info_; }
+    const std::array<double, 5>& metricWeights() const { return weights_; }
 
 private:
     struct Voice {
@@ -348,6 +352,7 @@ private:
     double fs_;
     std::optional<dsp::SteadyCurve> steady_;
     bool scaleFromRamps_ = false;
+    std::array<double, 5> weights_;
     /// Each stroke's own noise (seed 0), drawn once: every evaluation adds the same to that stroke.
     std::vector<std::vector<double>> noise_;
     mutable std::atomic<long long> simulations_{0};

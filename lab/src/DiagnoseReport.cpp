@@ -138,7 +138,7 @@ std::string describe(const std::string& effect, const std::vector<ErrorParts>& b
     // The part of the comparison the extension mended most, weighted as in the metric.
     const char* names[] = {"first-slip times", "bridge forces before the first slip", "first-slip jumps", "transient lengths",
                            "waveforms just after the first slip"};
-    const auto& weights = ErrorParts::kWeights;
+    const auto& weights = before.empty() ? ErrorParts::kWeights : before.front().weights;
     double b[5] = {0, 0, 0, 0, 0}, a[5] = {0, 0, 0, 0, 0};
     for (std::size_t i = 0; i < before.size(); ++i) {
         const double pb[] = {before[i].firstSlip, before[i].forceBeforeSlip, before[i].jump, before[i].transient, before[i].waveform};
@@ -302,6 +302,18 @@ std::pair<double, double> reportedInterval(const Finding& f, const std::string& 
 }
 
 namespace {
+/// The metric as diagnosis.json's gain.metric states it, with the weights it ran with.
+std::string metricInWords(const std::array<double, 5>& w)
+{
+    char buf[600];
+    std::snprintf(buf, sizeof buf,
+                  "mean over the test strokes of a weighted sum of five parts, each capped at 1: first-slip time (relative, %.3g), bridge "
+                  "force before the first slip (per newton of bow force, %.3g), first-slip jump (per newton, %.3g), transient length (per "
+                  "25 periods, failures as 30; %.3g) and waveform rms over 2 periods after the first slip (per ideal flyback, %.3g)%s",
+                  w[0], w[1], w[2], w[3], w[4], defaultMetricWeights(w) ? "" : "; not the default weights, with which the naming threshold was calibrated");
+    return buf;
+}
+
 std::string effectList(const std::vector<Finding>& list)
 {
     std::string out;
@@ -409,10 +421,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         {"baseline_model", d.baseline.name()},
         {"findings", findings},
         {"final_model", d.final.name()},
-        {"gain", {{"metric", "mean over the test strokes of a weighted sum of five parts, each capped at 1: first-slip time "
-                              "(relative, 0.25), bridge force before the first slip (per newton of bow force, 0.25), first-slip jump "
-                              "(per newton, 0.25), transient length (per 25 periods, failures as 30; 0.10) and waveform rms over 2 "
-                              "periods after the first slip (per ideal flyback, 0.15)"},
+        {"gain", {{"metric", metricInWords(o.metricWeights)},
                   {"baseline", d.baselineError}, {"final", d.finalError}, {"relative", d.relativeGain},
                   {"ci95", {d.gainLow, d.gainHigh}}, {"n_fit", d.nFit}, {"n_validation", d.nValidation}, {"n_heldout", d.nHeldout}}},
         {"calibration", calibration},
@@ -422,6 +431,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
                    {"floor_parts", d.residual.partFloor}}},
         {"rules", d.rules},
         {"search", searchSwitches(o)},
+        {"metric_weights", o.metricWeights},
         {"trials", trials},
         {"warnings", d.warnings}};
     std::ofstream(dir / "diagnosis.json") << doc.dump(1) << "\n";
@@ -580,6 +590,12 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
           "the no-effect value, so the discrepancy alone sets the weakest effect that can be named (the rules give it); the curvature, the drive halves and "
           "the rig unknowns can still widen a named finding's interval to the no-effect value, which the finding then says. The floor is the "
           "final model against itself with 1 % scatter of force and acceleration on the test strokes. "
+       << (defaultMetricWeights(o.metricWeights)
+               ? std::string()
+               : "The metric ran with other weights than its own (" + fmt(o.metricWeights[0]) + ", " + fmt(o.metricWeights[1]) + ", " +
+                     fmt(o.metricWeights[2]) + ", " + fmt(o.metricWeights[3]) + ", " + fmt(o.metricWeights[4]) +
+                     " for first-slip time, force before it, jump, transient length and waveform); the naming threshold and the "
+                     "model discrepancies were measured with 0.25, 0.25, 0.25, 0.1 and 0.15, so what this run names is not calibrated. ")
        << d.simulations << " simulations in " << fmt(d.seconds, "%.1f") << " s.\n";
     for (const auto& w : d.warnings) md << "\nWarning: " << w << "\n";
 }

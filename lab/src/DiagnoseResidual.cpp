@@ -37,7 +37,7 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
             std::uniform_real_distribution<double> j(-0.01, 0.01);
             const StrokeFeatures a = engine.simulate(current, i, nullptr, j(jr), j(jr), 1);
             const StrokeFeatures b = engine.simulate(current, i, nullptr, j(jr), j(jr), 2);
-            floorParts[k] = compare(a, b, strokes[i].gesture, engine.info());
+            floorParts[k] = compare(a, b, strokes[i].gesture, engine.info(), engine.metricWeights());
         });
         Residual r;
         r.error = mean(currentTest);
@@ -47,7 +47,7 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
         r.usual = o.usualResidualRatio;
         r.beyondUsual = r.present && r.usual > 0.0 && r.ratio > r.usual;
         const char* names[] = {"first-slip time", "bridge force before the first slip", "first-slip jump", "transient length", "waveform after the first slip"};
-        const auto& w = ErrorParts::kWeights;
+        const auto& w = engine.metricWeights();
         double partErr[5] = {0, 0, 0, 0, 0}, partFloor[5] = {0, 0, 0, 0, 0};
         for (std::size_t k = 0; k < testSet.size(); ++k) {
             const ErrorParts& e = currentTest[k];

@@ -20,6 +20,20 @@ std::map<std::string, bool> searchSwitches(const DiagnoseOptions& o)
     return {{"pairs", o.tryPairs}, {"contact_restart", o.restartContact}, {"second_start", o.secondStart}};
 }
 
+void checkMetricWeights(const std::array<double, 5>& weights, const std::string& what)
+{
+    double sum = 0;
+    for (double w : weights) {
+        if (!std::isfinite(w) || w < 0.0) throw LabError(what + ": every weight must be a finite number of 0 or more");
+        sum += w;
+    }
+    if (std::abs(sum - 1.0) > 1e-3) throw LabError(what + ": the five weights must sum to 1 (they sum to " + std::to_string(sum) + ")");
+    // A metric without the first slip's parts has nothing a friction law sets deterministically.
+    if (weights[0] + weights[1] + weights[2] <= 0.0) throw LabError(what + ": the first slip's three parts cannot all weigh 0");
+}
+
+bool defaultMetricWeights(const std::array<double, 5>& weights) { return weights == ErrorParts::kWeights; }
+
 StrokeSplit splitStrokes(const std::vector<StrokePlace>& places, const DiagnoseOptions& o, const std::string& setName)
 {
     const std::size_t n = places.size();

@@ -112,6 +112,28 @@ std::string describeSearch(const std::map<std::string, bool>& search)
     return text;
 }
 
+std::array<double, 5> metricWeightsOf(const json& diagnosis, const fs::path& file)
+{
+    if (!diagnosis.contains("metric_weights")) return ErrorParts::kWeights;
+    const json& w = diagnosis["metric_weights"];
+    if (!w.is_array() || w.size() != 5 || !std::all_of(w.begin(), w.end(), [](const json& x) { return x.is_number(); }))
+        throw LabError(file.string() + ": \"metric_weights\" is not a list of five numbers");
+    std::array<double, 5> weights{};
+    for (std::size_t k = 0; k < 5; ++k) weights[k] = w[k].get<double>();
+    return weights;
+}
+
+std::string describeMetricWeights(const std::array<double, 5>& weights)
+{
+    std::string text;
+    char buf[32];
+    for (double x : weights) {
+        std::snprintf(buf, sizeof buf, "%g", x);
+        text += (text.empty() ? "" : "/") + std::string(buf);
+    }
+    return text + (defaultMetricWeights(weights) ? " (the default)" : "");
+}
+
 json populationOf(const json& plan)
 {
     json p;
@@ -175,10 +197,15 @@ void runStudy(const fs::path& dir, const StudyOptions& o, const std::function<vo
                                "\"); a resumed study keeps its --split-per-set, --stratified-split and --diagnose-seed: use a new folder, or remove the sets' diagnosis folders");
         }
         if (const fs::path diagnosis = diagnosed / "diagnosis.json"; fs::exists(diagnosis)) {
-            const std::map<std::string, bool> was = searchRecordOf(readJsonFile(diagnosis), diagnosis);
+            const json record = readJsonFile(diagnosis);
+            const std::map<std::string, bool> was = searchRecordOf(record, diagnosis);
             if (!was.empty() && was != search)
                 throw LabError(diagnosis.string() + ": this set was diagnosed with " + describeSearch(was) + " where this run would search with " +
                                describeSearch(search) + "; a resumed study keeps its --pairs, --contact-restart and --second-start: use a new folder, or remove the sets' diagnosis folders");
+            // The metric's weights decide every fit and every naming, as the search does.
+            if (const auto weights = metricWeightsOf(record, diagnosis); weights != o.diagnose.metricWeights)
+                throw LabError(diagnosis.string() + ": this set was diagnosed with metric weights " + describeMetricWeights(weights) + " where this run has " +
+                               describeMetricWeights(o.diagnose.metricWeights) + "; a resumed study keeps its --metric-weights: use a new folder, or remove the sets' diagnosis folders");
         }
     }
     std::size_t done = 0;

@@ -2,6 +2,7 @@
 // scores it): read from its folder, and the part of it that names the population its sets come
 // from. Internal to lab/.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -28,6 +29,11 @@ std::map<std::string, bool> searchRecordOf(const nlohmann::json& diagnosis, cons
 /// "contact_restart on, pairs off, second_start off" (the switches in name order), or "not
 /// recorded" for an empty record.
 std::string describeSearch(const std::map<std::string, bool>& search);
+/// A diagnosis.json's metric weights; a diagnosis from before they were recorded ran with the
+/// metric's own (ErrorParts::kWeights). A malformed record is refused naming `file`.
+std::array<double, 5> metricWeightsOf(const nlohmann::json& diagnosis, const std::filesystem::path& file);
+/// "0.25/0.25/0.25/0.1/0.15 (the default)", or without the remark for other weights.
+std::string describeMetricWeights(const std::array<double, 5>& weights);
 
 /// What must match for studies to be scored as one: the strokes, the rig population and the
 /// effects' size ranges (a study of narrowed sizes would skew a pooled detection rate). The seed,

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -88,6 +89,7 @@ struct Scored {
     std::string splitMethod = "random";
     std::uint64_t splitSeed = 0; ///< split.json's seed (0 where the diagnosis wrote none)
     std::map<std::string, bool> search; ///< diagnosis.json's search switches (empty: not recorded)
+    std::array<double, 5> metricWeights = ErrorParts::kWeights; ///< diagnosis.json's metric weights
 };
 
 std::string fmt(const char* f, double x)
@@ -208,6 +210,7 @@ Scored readScored(const fs::path& f)
         s.splitSeed = r.seed;
     }
     s.search = searchRecordOf(d, f / "diagnosis" / "diagnosis.json");
+    s.metricWeights = metricWeightsOf(d, f / "diagnosis" / "diagnosis.json");
     s.baseline = d["gain"]["baseline"].get<double>();
     s.final = d["gain"]["final"].get<double>();
     s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
@@ -236,6 +239,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     std::pair<std::string, std::string> unitsSeen; // the first set's units (Scored::units) and where it was met
     std::pair<std::string, std::string> splitSeen; // the first set's split method and where it was met
     std::pair<std::map<std::string, bool>, std::string> searchSeen; // the first recorded search switches and where they were met
+    std::optional<std::pair<std::array<double, 5>, std::string>> weightsSeen; // the first set's metric weights and where they were met
     std::string sources;
     std::vector<Scored> sets;
     for (const fs::path& study : studies) {
@@ -273,6 +277,11 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
                     throw LabError(f.string() + "/diagnosis/diagnosis.json: search " + describeSearch(s.search) + " where " + searchSeen.second +
                                    " has " + describeSearch(searchSeen.first) + ": studies scored together must search the same way");
             }
+            // And so is the metric: the same sets read with other weights are another experiment.
+            if (!weightsSeen) weightsSeen = {{s.metricWeights, f.string()}};
+            else if (s.metricWeights != weightsSeen->first)
+                throw LabError(f.string() + "/diagnosis/diagnosis.json: metric weights " + describeMetricWeights(s.metricWeights) + " where " +
+                               weightsSeen->second + " has " + describeMetricWeights(weightsSeen->first) + ": studies scored together must use one metric");
             // The same set counted twice (one study pooled twice, or two folders of one seed) would
             // pass for a larger study.
             if (const auto [at, fresh] = seenSeeds.emplace(s.seed, f.string()); !fresh && s.seed != 0)
@@ -315,6 +324,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     md << "Search: " << describeSearch(searchSeen.first)
        << (unrecorded > 0 && !searchSeen.first.empty() ? " (" + std::to_string(unrecorded) + " sets diagnosed before diagnosis.json recorded it)" : "")
        << ".\n";
+    md << "Metric weights (first-slip time, force before it, jump, transient length, waveform): " << describeMetricWeights(weightsSeen->first) << ".\n";
     md << "Sets named exactly right (every hidden effect and nothing else): " << exact << " of " << sets.size() << ".\n";
     md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
     // What the models on the list could not explain, and how far above the sets' own floors.
@@ -385,6 +395,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     summary["split_method"] = splitSeen.first;
     summary["split_seeds"] = splitSeeds.size();
     if (!searchSeen.first.empty()) summary["search"] = searchSeen.first;
+    summary["metric_weights"] = weightsSeen->first;
     summary["exact"] = exact;
     summary["null_sets"] = nNull;
     summary["null_false_positives"] = nullFp;

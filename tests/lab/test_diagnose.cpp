@@ -725,6 +725,76 @@ TEST(DiagnoseSystematic, ARepeatedStrokeIsSimulatedOnceAndScoredAsOftenAsItAppea
     }
 }
 
+// The metric's weights are an option (DiagnoseOptions::metricWeights): the engine scores every
+// part as before and weighs them with the weights it was given, the signed parts a linearised
+// fit sees scale with them, and weights that would make the metric say nothing are refused.
+TEST(DiagnoseSystematic, TheMetricWeighsItsPartsWithTheWeightsItIsGiven)
+{
+    diag::StringInfo info;
+    Diagnosis d;
+    std::vector<diag::Prepared> strokes = preparedModelSet({"thermal_memory"}, 31, info, d);
+    const DiagnoseOptions o;
+    const std::array<double, 5> noTransient{0.3, 0.3, 0.25, 0.0, 0.15};
+    const diag::Engine usual(strokes, info, o.simRate, std::nullopt, false);
+    const diag::Engine other(strokes, info, o.simRate, std::nullopt, false, noTransient);
+    const EffectModel m; // the friction-curve baseline on a thermal set: every part disagrees somewhere
+    std::vector<std::size_t> all(strokes.size());
+    std::iota(all.begin(), all.end(), std::size_t(0));
+    const std::vector<ErrorParts> a = usual.errors(m, all), b = other.errors(m, all);
+    const Eigen::VectorXd sa = usual.signedResiduals(m, all), sb = other.signedResiduals(m, all);
+    double transientShare = 0;
+    for (std::size_t k = 0; k < all.size(); ++k) {
+        EXPECT_EQ(a[k].transient, b[k].transient) << "the parts do not depend on the weights";
+        EXPECT_EQ(a[k].waveform, b[k].waveform);
+        EXPECT_DOUBLE_EQ(a[k].total(), 0.25 * (a[k].firstSlip + a[k].forceBeforeSlip + a[k].jump) + 0.1 * a[k].transient + 0.15 * a[k].waveform);
+        EXPECT_DOUBLE_EQ(b[k].total(), 0.3 * (b[k].firstSlip + b[k].forceBeforeSlip) + 0.25 * b[k].jump + 0.15 * b[k].waveform);
+        transientShare += 0.1 * a[k].transient;
+        const auto row = static_cast<Eigen::Index>(4 * k);
+        EXPECT_NEAR(sb[row], 1.2 * sa[row], 1e-12);
+        EXPECT_NEAR(sb[row + 1], 1.2 * sa[row + 1], 1e-12);
+        EXPECT_NEAR(sb[row + 2], sa[row + 2], 1e-12);
+        EXPECT_EQ(sb[row + 3], 0.0) << "a part weighted 0 gives a fit nothing to take up";
+    }
+    EXPECT_GT(transientShare, 0.0) << "the strokes' transients differ, so dropping the part must show";
+
+    EXPECT_NO_THROW(checkMetricWeights(ErrorParts::kWeights, "w"));
+    EXPECT_NO_THROW(checkMetricWeights(noTransient, "w"));
+    EXPECT_TRUE(defaultMetricWeights(o.metricWeights));
+    EXPECT_FALSE(defaultMetricWeights(noTransient));
+    const auto refusal = [](const std::array<double, 5>& w) {
+        try {
+            checkMetricWeights(w, "--metric-weights");
+        } catch (const LabError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(refusal({0.3, 0.3, 0.3, 0.1, 0.1}).find("--metric-weights: the five weights must sum to 1 (they sum to 1.1"), std::string::npos);
+    EXPECT_NE(refusal({0.5, 0.5, 0.2, -0.2, 0.0}).find("finite number of 0 or more"), std::string::npos);
+    EXPECT_NE(refusal({0.5, 0.5, std::nan(""), 0.0, 0.0}).find("finite number of 0 or more"), std::string::npos);
+    EXPECT_NE(refusal({0.0, 0.0, 0.0, 0.5, 0.5}).find("the first slip's three parts cannot all weigh 0"), std::string::npos);
+
+    // A diagnosis records the weights, its metric says them, and other weights are flagged as
+    // uncalibrated in the report (the naming threshold was measured with the default).
+    DiagnoseOptions reweighted;
+    reweighted.metricWeights = noTransient;
+    const fs::path dir = fs::temp_directory_path() / ("rosin-weights-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    writeDiagnosis(dir, Diagnosis{}, reweighted);
+    nlohmann::json doc;
+    std::ifstream(dir / "diagnosis.json") >> doc;
+    EXPECT_EQ(doc["metric_weights"], nlohmann::json(noTransient));
+    EXPECT_NE(doc["gain"]["metric"].get<std::string>().find("transient length (per 25 periods, failures as 30; 0)"), std::string::npos);
+    std::ifstream in(dir / "report.md");
+    const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(md.find("The metric ran with other weights than its own (0.3, 0.3, 0.25, 0, 0.15"), std::string::npos) << md;
+    writeDiagnosis(dir, Diagnosis{}, DiagnoseOptions{});
+    std::ifstream in2(dir / "report.md");
+    const std::string usualMd((std::istreambuf_iterator<char>(in2)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(usualMd.find("other weights than its own"), std::string::npos);
+    fs::remove_all(dir);
+}
+
 namespace {
 constexpr double kRampRate = 48000.0;
 constexpr double kCelloBeta = 0.0899; // the cello D bow position of the reference tests

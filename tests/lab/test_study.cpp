@@ -537,6 +537,17 @@ TEST(Study, ASplitPerSetGivesEverySetItsOwnReproducibleSplit)
     o.diagnose.tryPairs = true;
     EXPECT_NE(refusal(o).find("pairs on"), std::string::npos);
     o.diagnose.tryPairs = false;
+    // And other metric weights: every fit and every naming would be another experiment.
+    EXPECT_NE(oneSplit.find("Metric weights (first-slip time, force before it, jump, transient length, waveform): 0.25/0.25/0.25/0.1/0.15 (the default).\n"),
+              std::string::npos)
+        << oneSplit;
+    o.diagnose.metricWeights = {0.3, 0.3, 0.3, 0.0, 0.1};
+    const std::string otherMetric = refusal(o);
+    EXPECT_NE(otherMetric.find("000/diagnosis/diagnosis.json: this set was diagnosed with metric weights 0.25/0.25/0.25/0.1/0.15 (the default) where "
+                               "this run has 0.3/0.3/0.3/0/0.1; a resumed study keeps its --metric-weights"),
+              std::string::npos)
+        << otherMetric;
+    o.diagnose.metricWeights = ErrorParts::kWeights;
     EXPECT_EQ(fs::last_write_time(setDir(dir, 0) / "diagnosis" / "diagnosis.json"), before);
     fs::remove_all(dir);
 }
@@ -989,6 +1000,27 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     scoreStudies(out, {a, b});
     std::ifstream(out / "study.json") >> study;
     EXPECT_EQ(study["summary"]["search"]["second_start"], true);
+    // And so is the metric's weighting; a diagnosis that does not record it ran with the default.
+    const auto writeWeights = [](const fs::path& folder, int index, const json& weights) {
+        const fs::path file = setDir(folder, index) / "diagnosis" / "diagnosis.json";
+        json d;
+        std::ifstream(file) >> d;
+        d["metric_weights"] = weights;
+        std::ofstream(file) << d.dump();
+    };
+    writeWeights(a, 1, {0.25, 0.25, 0.25, 0.1, 0.15});
+    EXPECT_NE(scoreStudies(out, {a, b}).find("Metric weights (first-slip time, force before it, jump, transient length, waveform): 0.25/0.25/0.25/0.1/0.15 (the default)."),
+              std::string::npos);
+    writeWeights(b, 1, {0.3, 0.3, 0.3, 0.0, 0.1});
+    const std::string metrics = poolRefusal(out, {a, b});
+    EXPECT_NE(metrics.find("/diagnosis/diagnosis.json: metric weights 0.3/0.3/0.3/0/0.1 where "), std::string::npos) << metrics;
+    EXPECT_NE(metrics.find("must use one metric"), std::string::npos) << metrics;
+    writeWeights(b, 1, {0.3, 0.3});
+    EXPECT_NE(poolRefusal(out, {a, b}).find("\"metric_weights\" is not a list of five numbers"), std::string::npos);
+    writeWeights(b, 1, {0.25, 0.25, 0.25, 0.1, 0.15});
+    scoreStudies(out, {a, b});
+    std::ifstream(out / "study.json") >> study;
+    EXPECT_EQ(study["summary"]["metric_weights"][3], 0.1);
     // One study scored on its own keeps its plain labels and gains no "pooled_from".
     scoreStudy(a);
     json alone;

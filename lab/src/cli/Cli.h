@@ -50,6 +50,23 @@ inline void addSearchFlags(CLI::App& cmd, DiagnoseOptions& o)
                  "Refine every fit gridded over two or more parameters also from the best grid point two steps from the grid's best, and keep the better end" +
                      byDefault(o.secondStart))
         ->capture_default_str();
+    cmd.add_option_function<std::vector<double>>(
+           "--metric-weights",
+           [&o](const std::vector<double>& w) {
+               if (w.size() != 5) throw CLI::ValidationError("--metric-weights", "give five weights: first-slip time, force before it, jump, transient length, waveform");
+               std::array<double, 5> weights{};
+               std::copy(w.begin(), w.end(), weights.begin());
+               try {
+                   checkMetricWeights(weights, "--metric-weights");
+               } catch (const LabError& e) {
+                   throw CLI::ValidationError(e.what());
+               }
+               o.metricWeights = weights;
+           },
+           "The metric's part weights: first-slip time, bridge force before it, jump, transient length, waveform, summing to 1 "
+           "(default 0.25,0.25,0.25,0.1,0.15; the naming threshold and the studies' discrepancies were measured with the default)")
+        ->delimiter(',')
+        ->expected(5);
     cmd.add_flag("--stratified-split,!--random-split", o.stratifiedSplit,
                  "Deal fit, validation and test strokes so that every gesture, drive and bow force of the set gives each its share, "
                  "instead of a shuffle of the whole set" + byDefault(o.stratifiedSplit))

@@ -3,6 +3,7 @@
 // part of the strokes, keep the one that helps most on the strokes held out (if significantly),
 // and repeat until nothing helps.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -46,11 +47,13 @@ struct StrokeFeatures {
 /// dependence), so they weigh less: otherwise their scatter hides real effects.
 struct ErrorParts {
     double firstSlip = 0, forceBeforeSlip = 0, jump = 0, transient = 0, waveform = 0;
-    /// the parts' weights in the metric, in the order above
-    static constexpr double kWeights[5] = {0.25, 0.25, 0.25, 0.10, 0.15};
+    /// the parts' weights in the metric by default, in the order above
+    static constexpr std::array<double, 5> kWeights{0.25, 0.25, 0.25, 0.10, 0.15};
+    /// the weights this comparison was made with (DiagnoseOptions::metricWeights)
+    std::array<double, 5> weights = kWeights;
     double total() const
     {
-        return kWeights[0] * firstSlip + kWeights[1] * forceBeforeSlip + kWeights[2] * jump + kWeights[3] * transient + kWeights[4] * waveform;
+        return weights[0] * firstSlip + weights[1] * forceBeforeSlip + weights[2] * jump + weights[3] * transient + weights[4] * waveform;
     }
 };
 
@@ -100,6 +103,11 @@ struct DiagnoseOptions {
     /// from the wrong end stopped at the contact's absence (docs/diagnosis-study.md, forty-first
     /// session). Off until studies have measured it.
     bool secondStart = false;
+    /// The metric's part weights (first-slip time, force before it, jump, transient length,
+    /// waveform), summing to 1. The naming threshold, the usual residual and the model
+    /// discrepancies were all measured with ErrorParts::kWeights: other weights are for studies
+    /// that measure them again (checkMetricWeights() says what is refused).
+    std::array<double, 5> metricWeights = ErrorParts::kWeights;
     bool fitNuisances = true;       ///< tension, bow position (and, in thermal models, the bow side's effusivity) as calibration
     /// The model's own error on rigs it does not describe (their thermal constants, an unnamed
     /// torsion): the standard deviation that a finding's parameter still misses the truth by
@@ -256,6 +264,12 @@ const char* splitMethodName(const DiagnoseOptions& options);
 /// The options' search switches as diagnosis.json's "search" records them (pairs,
 /// contact_restart, second_start): a study resumes and pools only diagnoses that searched alike.
 std::map<std::string, bool> searchSwitches(const DiagnoseOptions& options);
+/// Metric weights a diagnosis can take: five finite, non-negative numbers summing to 1 within
+/// 1e-6, the first three (the first slip's parts, which the physics sets) not all zero. Throws
+/// LabError naming `what` otherwise.
+void checkMetricWeights(const std::array<double, 5>& weights, const std::string& what);
+/// True when the weights are the metric's own (ErrorParts::kWeights).
+bool defaultMetricWeights(const std::array<double, 5>& weights);
 
 Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& options,
                    const std::function<void(const std::string&, double)>& progress = {});
