@@ -13,6 +13,7 @@
 
 #include "DiagnoseEngine.h"
 #include "StudyPlan.h"
+#include "StudyScored.h"
 #include "rosin/dsp/FrictionLaws.h"
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Plot.h"
@@ -22,128 +23,14 @@
 namespace rosin::lab {
 namespace fs = std::filesystem;
 using nlohmann::json;
+using namespace scoring;
 
 namespace {
-
-bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
-
-/// How far an effect is from its own absence, for detection against size (thermal memory has
-/// no such value: the thermal law is a different law, not a parameter's end).
-double effectSize(const std::string& effect, const std::map<std::string, double>& truth)
-{
-    if (effect == "hertzian_contact") return 1.0 - truth.at("load_exponent");
-    if (effect == "rosin_temperature_shift") return std::abs(truth.at("shift_k"));
-    if (effect == "torsional_compliance") return 1.0 / truth.at("zt_ratio");
-    if (effect == "rate_dependence") return truth.at("p");
-    return std::nan("");
-}
-
-const char* sizeName(const std::string& effect)
-{
-    if (effect == "hertzian_contact") return "1 - n";
-    if (effect == "rosin_temperature_shift") return "|dT| (K)";
-    if (effect == "torsional_compliance") return "Z0/Zt";
-    if (effect == "rate_dependence") return "p";
-    return "-";
-}
-
-/// The tolerances issue 20 asks of a named parameter (relative where marked).
-struct Tolerance {
-    double value;
-    bool relative;
-};
-const std::map<std::string, Tolerance>& tolerances()
-{
-    static const std::map<std::string, Tolerance> t{{"load_exponent", {0.05, false}}, {"shift_k", {3.0, false}}, {"zt_ratio", {0.2, true}},
-                                                    {"r_A", {0.1, true}},           {"p", {0.1, false}},       {"h0", {0.1, false}}};
-    return t;
-}
-
-struct Scored {
-    int index = 0;
-    std::string study; ///< the study folder's name, when several studies are scored together
-    std::uint64_t seed = 0;
-    std::vector<std::string> hidden, found;
-    std::map<std::string, double> truth;
-    std::map<std::string, std::array<double, 3>> estimate; ///< value, ci low, ci high
-    /// the interval without the drive halves' refits (bootstrap and curvature only), where given
-    std::map<std::string, std::array<double, 2>> withoutHalves;
-    /// the statistical interval (bootstrap, curvature, drive halves), and that with the rig
-    /// unknowns' moves added: the reported one less the model discrepancy, where given
-    std::map<std::string, std::array<double, 2>> statistical, withRig;
-    std::set<std::string> unidentified; ///< reported as not identified: interval = search range
-    std::map<std::string, std::array<double, 3>> calibration; ///< nuisance -> value, ci low, ci high
-    std::map<std::string, std::array<double, 2>> calibrationCurvature; ///< nuisance -> its curvature interval alone, where given
-    /// fitted nuisances whose reported interval is the curvature's alone: diagnosed before the
-    /// calibration discrepancy widened it (no ci95_curvature beside it)
-    std::set<std::string> calibrationNotWidened;
-    std::map<std::string, double> rig;
-    double baseline = 0, final = 0;
-    bool unexplained = false;
-    bool beyondUsual = false;  ///< the residual is above the usual ratio the diagnosis compared it with
-    std::vector<std::string> standIns; ///< effects set aside beside a residual beyond the usual one (rule 6): not named
-    double overFloor = 0;      ///< the final error over the set's noise-and-chaos floor
-    std::string units;         ///< "V" or "N" as the diagnosis read the set ("" when it does not say)
-    /// how the diagnosis dealt the strokes into fit, validation and test (split.json's "method";
-    /// diagnoses from before the stratified split have no method and were all "random")
-    std::string splitMethod = "random";
-    std::uint64_t splitSeed = 0; ///< split.json's seed (0 where the diagnosis wrote none)
-    std::map<std::string, bool> search; ///< diagnosis.json's search switches (empty: not recorded)
-    std::array<double, 5> metricWeights = ErrorParts::kWeights; ///< diagnosis.json's metric weights
-};
-
 std::string fmt(const char* f, double x)
 {
     char b[256];
     std::snprintf(b, sizeof b, f, x);
     return b;
-}
-
-void drawFigure(const fs::path& file, const std::vector<Scored>& sets)
-{
-    Canvas canvas(1200, 500);
-    const std::vector<std::string>& ids = effectIds();
-    // Left: detection and false-positive rate per effect, and the null sets' false positives.
-    Axes left(canvas, 70, 40, 520, 330, -0.5, static_cast<double>(ids.size()) + 0.5, 0.0, 1.05);
-    left.frame("detection (blue) and false positives (red) per effect", "", "fraction of sets");
-    for (std::size_t k = 0; k <= ids.size(); ++k) {
-        double hid = 0, det = 0, not_ = 0, fp = 0;
-        for (const auto& s : sets) {
-            if (k == ids.size()) {
-                if (s.hidden.empty()) { ++not_; fp += !s.found.empty(); }
-                continue;
-            }
-            if (has(s.hidden, ids[k])) { ++hid; det += has(s.found, ids[k]); }
-            else { ++not_; fp += has(s.found, ids[k]); }
-        }
-        const double x = static_cast<double>(k);
-        if (hid > 0) left.rect(x - 0.35, 0.0, x - 0.02, det / hid, colors::blue);
-        if (not_ > 0) left.rect(x + 0.02, 0.0, x + 0.35, std::max(0.005, fp / not_), colors::red);
-        const std::string label = k == ids.size() ? "null sets" : ids[k].substr(0, ids[k].find('_'));
-        canvas.text(left.px(x), left.py(0.0) + 30, label, 11, colors::black, 0.5, 0.0);
-    }
-    left.hline(0.9, colors::grey, 1.0, true);
-    left.hline(0.05, colors::grey, 1.0, true);
-    // Right: detection against effect size, each effect's size scaled to its prior's top.
-    Axes right(canvas, 680, 40, 480, 330, 0.0, 1.05, -0.15, 1.15);
-    right.frame("named (1) or missed (0) against effect size", "size / largest size in the prior", "named");
-    const std::vector<std::pair<std::string, Color>> kinds{{"hertzian_contact", colors::blue}, {"rosin_temperature_shift", colors::red},
-                                                           {"torsional_compliance", colors::green}, {"rate_dependence", colors::orange}};
-    const std::map<std::string, double> top{{"hertzian_contact", 0.45}, {"rosin_temperature_shift", 20.0}, {"torsional_compliance", 1.0 / 1.2},
-                                            {"rate_dependence", 0.6}};
-    std::vector<std::pair<std::string, Color>> legend;
-    for (const auto& [effect, color] : kinds) {
-        std::vector<double> x, y;
-        for (const auto& s : sets)
-            if (has(s.hidden, effect)) {
-                x.push_back(effectSize(effect, s.truth) / top.at(effect));
-                y.push_back((has(s.found, effect) ? 1.0 : 0.0) + 0.03 * (static_cast<double>(s.index % 5) - 2.0));
-            }
-        right.points(x, y, color, 4.0);
-        legend.push_back({effect.substr(0, effect.find('_')) + " (" + sizeName(effect) + ")", color});
-    }
-    right.legendBelow(legend);
-    canvas.save(file);
 }
 
 /// A plan's object as "key<text>, key<text>", each text written from its value by `entry`.
@@ -153,78 +40,202 @@ std::string joined(const json& items, const std::function<std::string(const json
     for (const auto& [k, v] : items.items()) out += (out.empty() ? "" : ", ") + k + entry(v);
     return out;
 }
-
-/// One set's truth and diagnosis, as the scoring needs them (`f` is DIR/sets/NNN).
-Scored readScored(const fs::path& f)
+/// The named parameters against the truth (error, tolerance, coverage of the intervals and
+/// their parts, per study when pooled) and the model discrepancy the sets measure.
+void scoreParameters(std::ostringstream& md, json& summary, const std::vector<Scored>& sets)
 {
-    json t, d;
-    std::ifstream(f / "truth.json") >> t;
-    std::ifstream(f / "diagnosis" / "diagnosis.json") >> d;
-    Scored s;
-    s.index = std::stoi(f.filename().string());
-    s.seed = t.value("seed", 0ull);
-    s.hidden = t["effects"].get<std::vector<std::string>>();
-    s.truth = t["params"].get<std::map<std::string, double>>();
-    if (t.contains("rig")) s.rig = t["rig"].get<std::map<std::string, double>>();
-    // The sensor's true scale is the inverse of the gain the generator applied.
-    if (t.contains("gain_units_per_N") && t["gain_units_per_N"].get<double>() > 0.0)
-        s.rig["scale_n_per_unit"] = 1.0 / t["gain_units_per_N"].get<double>();
-    for (const auto& finding : d["findings"]) {
-        const std::string e = finding["effect"].get<std::string>();
-        if (e == "none") continue;
-        s.found.push_back(e);
-        for (const auto& [name, v] : finding["parameters"].items()) {
-            s.estimate[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
-            if (v.contains("identified") && !v["identified"].get<bool>()) s.unidentified.insert(name);
-            if (v.contains("ci95_bootstrap")) {
-                std::array<double, 2> w{v["ci95_bootstrap"][0].get<double>(), v["ci95_bootstrap"][1].get<double>()};
-                if (v.contains("ci95_curvature"))
-                    w = {std::min(w[0], v["ci95_curvature"][0].get<double>()), std::max(w[1], v["ci95_curvature"][1].get<double>())};
-                s.withoutHalves[name] = w;
+    md << "\n| parameter | named sets | median error | worst error | within the issue's tolerance | truth inside the 95 % interval |\n|---|---|---|---|---|---|\n";
+    int covered = 0, intervals = 0, coveredWithoutHalves = 0, coveredStatistical = 0, coveredWithRig = 0;
+    // The model discrepancy this study measures: the spread of (found - true) beyond what the
+    // statistical and rig-unknown intervals allow, by moments (relative for r_A and zt_ratio).
+    std::map<std::string, std::pair<double, int>> excess;
+    std::map<std::string, std::pair<int, int>> coverageByStudy; ///< pooled: study -> covered, intervals
+    for (const std::string& p : physicalParameterNames()) {
+        std::vector<double> err;
+        int within = 0, inside = 0, unidentified = 0;
+        const Tolerance tol = tolerances().at(p);
+        for (const auto& s : sets) {
+            if (!s.truth.count(p) || !s.estimate.count(p) || !has(s.found, effectOfParameter(p))) continue;
+            const double t = s.truth.at(p), v = s.estimate.at(p)[0];
+            const double e = tol.relative ? std::abs(v / t - 1.0) : std::abs(v - t);
+            err.push_back(e);
+            within += e <= tol.value;
+            // An interval as wide as the search range holds any truth and says nothing: such a
+            // parameter is counted apart, not as covered.
+            if (s.unidentified.count(p)) {
+                ++unidentified;
+                continue;
             }
-            if (v.contains("ci95_statistical")) {
-                const double x = v["value"].get<double>(), lo = v["ci95_statistical"][0].get<double>(), hi = v["ci95_statistical"][1].get<double>();
-                s.statistical[name] = {lo, hi};
-                const double down = v.contains("systematic_moves") ? v["systematic_moves"][0].get<double>() : 0.0;
-                const double up = v.contains("systematic_moves") ? v["systematic_moves"][1].get<double>() : 0.0;
-                const auto [rigLo, rigHi] = widenedInQuadrature(x, {lo, hi}, down, up);
-                s.withRig[name] = {rigLo, rigHi};
+            const bool in = t >= s.estimate.at(p)[1] && t <= s.estimate.at(p)[2];
+            inside += in;
+            covered += in;
+            ++intervals;
+            coverageByStudy[s.study].first += in;
+            ++coverageByStudy[s.study].second;
+            const auto narrow = s.withoutHalves.find(p);
+            coveredWithoutHalves += narrow != s.withoutHalves.end() ? t >= narrow->second[0] && t <= narrow->second[1] : in;
+            const auto stat = s.statistical.find(p);
+            coveredStatistical += stat != s.statistical.end() ? t >= stat->second[0] && t <= stat->second[1] : in;
+            const auto rig = s.withRig.find(p);
+            coveredWithRig += rig != s.withRig.end() ? t >= rig->second[0] && t <= rig->second[1] : in;
+            if (rig != s.withRig.end()) {
+                const double unit = discrepancyIsRelative(p) ? std::abs(t) : 1.0;
+                const double sd = (rig->second[1] - rig->second[0]) / (2.0 * 1.96) / unit, miss = (v - t) / unit;
+                excess[p].first += miss * miss - sd * sd;
+                ++excess[p].second;
             }
         }
+        if (err.empty()) {
+            md << "| " << p << " | 0 | - | - | - | - |\n";
+            continue;
+        }
+        std::sort(err.begin(), err.end());
+        const char* unit = tol.relative ? "%.1f %%" : "%.3g";
+        const double k = tol.relative ? 100.0 : 1.0;
+        md << "| " << p << " | " << err.size() << " | " << fmt(unit, k * err[err.size() / 2]) << " | " << fmt(unit, k * err.back()) << " | "
+           << within << " (tolerance " << fmt(unit, k * tol.value) << ") | " << inside << " of " << err.size() - static_cast<std::size_t>(unidentified)
+           << (unidentified ? " (" + std::to_string(unidentified) + " not identified)" : std::string()) << " |\n";
+        summary["parameters"][p] = {{"named", err.size()}, {"median_error", err[err.size() / 2]}, {"worst_error", err.back()},
+                                    {"within_tolerance", within}, {"covered", inside}, {"not_identified", unidentified}};
     }
-    if (d.contains("calibration") && d["calibration"].contains("values"))
-        for (const auto& [name, v] : d["calibration"]["values"].items())
-            if (v["value"].is_number() && v["ci95"].size() == 2) {
-                s.calibration[name] = {v["value"].get<double>(), v["ci95"][0].get<double>(), v["ci95"][1].get<double>()};
-                if (v.contains("ci95_curvature") && v["ci95_curvature"].size() == 2) {
-                    s.calibrationCurvature[name] = {v["ci95_curvature"][0].get<double>(), v["ci95_curvature"][1].get<double>()};
-                } else if (diag::isNuisance(name)) {
-                    // Fitted, but from a diagnosis before the widening: its interval is the curvature's.
-                    s.calibrationCurvature[name] = {s.calibration[name][1], s.calibration[name][2]};
-                    s.calibrationNotWidened.insert(name);
-                }
+    md << fmt("\nCoverage of the 95 %% intervals over all named parameters that the data identify: %.0f %%", intervals ? 100.0 * covered / intervals : 0.0)
+       << " (" << covered << " of " << intervals << ")"
+       << fmt("; statistical part only (bootstrap, curvature, drive halves): %.0f %%", intervals ? 100.0 * coveredStatistical / intervals : 0.0)
+       << " (" << coveredStatistical << fmt("); with the rig unknowns, without the model discrepancy: %.0f %%", intervals ? 100.0 * coveredWithRig / intervals : 0.0)
+       << " (" << coveredWithRig << fmt("); bootstrap and curvature only: %.0f %%", intervals ? 100.0 * coveredWithoutHalves / intervals : 0.0)
+       << " (" << coveredWithoutHalves << ").\n";
+    // Pooled: each seed's own coverage, since the issue asks it of every study, not of the pool.
+    if (coverageByStudy.size() > 1) {
+        md << "\nBy study:";
+        const char* sep = " ";
+        for (const auto& [name, c] : coverageByStudy) {
+            md << sep << name << fmt(" %.0f %%", 100.0 * c.first / c.second) << " (" << c.first << " of " << c.second << ")";
+            summary["coverage_by_study"][name] = {{"covered", c.first}, {"intervals", c.second}};
+            sep = ", ";
+        }
+        md << ".\n";
+    }
+    md << "\nModel discrepancy this study measures (standard deviation of found - true beyond the statistical and rig-unknown intervals; "
+          "relative for r_A and zt_ratio; `rosin diagnose --model-discrepancy NAME=SD` takes it):";
+    for (const auto& [p, e] : excess) {
+        const double sd = std::sqrt(std::max(0.0, e.first / e.second));
+        md << " " << p << fmt(" %.3g", sd) << " (" << e.second << " sets);";
+        summary["model_discrepancy"][p] = sd;
+        // The raw moments too, so that studies of several seeds pool exactly:
+        // sd = sqrt(sum of excess_sum / sum of sets), clipped at 0 only once.
+        summary["model_discrepancy_moments"][p] = {{"excess_sum", e.first}, {"sets", e.second}};
+    }
+    md << "\n";
+    summary["coverage_statistical"] = intervals ? static_cast<double>(coveredStatistical) / intervals : 0.0;
+    summary["coverage_with_rig_unknowns"] = intervals ? static_cast<double>(coveredWithRig) / intervals : 0.0;
+    summary["coverage"] = intervals ? static_cast<double>(covered) / intervals : 0.0;
+    summary["coverage_without_halves"] = intervals ? static_cast<double>(coveredWithoutHalves) / intervals : 0.0;
+}
+
+void scoreCalibration(std::ostringstream& md, json& summary, const std::vector<Scored>& sets)
+{
+    // Nuisances: what the rig really was against what the diagnosis calibrated (not findings,
+    // so not in the coverage above, but their intervals should mean what they say too).
+    // Tension and bow position are 1 + the rig's relative error of the same quantity; the rod's
+    // effusivity is the rig's value over the model's nominal, which the diagnosis scales.
+    struct RigSide {
+        const char* nuisance;
+        const char* rigKey;
+        double offset, divisor;
+    };
+    const RigSide nuisanceOfRig[]{{"tension_scale", "tension_error", 1.0, 1.0},
+                                  {"beta_scale", "beta_error", 1.0, 1.0},
+                                  {"rod_effusivity_scale", "rod_effusivity", 0.0, dsp::ThermalParams{}.rodEffusivity},
+                                  {"scale_n_per_unit", "scale_n_per_unit", 0.0, 1.0}};
+    // Each fitted nuisance's discrepancy: the spread of (value - truth) beyond its curvature
+    // interval, as for the findings' parameters (what `--model-discrepancy NAME=SD` takes).
+    md << "\n| calibrated nuisance | sets | median error | worst error | truth inside the 95 % interval | inside the curvature interval alone | "
+          "discrepancy beyond the curvature (SD) |\n|---|---|---|---|---|---|---|\n";
+    for (const auto& [name, rigKey, offset, divisor] : nuisanceOfRig) {
+        std::vector<double> err;
+        int inside = 0, insideCurvature = 0, withCurvature = 0, notWidened = 0, insideNotWidened = 0;
+        double excessSum = 0.0;
+        for (const auto& s : sets) {
+            if (!s.calibration.count(name) || !s.rig.count(rigKey)) continue;
+            const double t = offset + s.rig.at(rigKey) / divisor;
+            const auto& c = s.calibration.at(name);
+            err.push_back(std::abs(c[0] / t - 1.0));
+            inside += t >= c[1] && t <= c[2];
+            if (s.calibrationNotWidened.count(name)) {
+                ++notWidened;
+                insideNotWidened += t >= c[1] && t <= c[2];
             }
-    if (const fs::path split = f / "diagnosis" / "split.json"; fs::exists(split)) {
-        const SplitRecord r = readSplitRecord(split);
-        s.splitMethod = r.method;
-        s.splitSeed = r.seed;
+            if (const auto k = s.calibrationCurvature.find(name); k != s.calibrationCurvature.end()) {
+                ++withCurvature;
+                insideCurvature += t >= k->second[0] && t <= k->second[1];
+                const double sd = (k->second[1] - k->second[0]) / (2.0 * 1.96);
+                excessSum += (c[0] - t) * (c[0] - t) - sd * sd;
+            }
+        }
+        if (err.empty()) continue;
+        std::sort(err.begin(), err.end());
+        md << "| " << name << " | " << err.size() << " | " << fmt("%.1f %%", 100.0 * err[err.size() / 2]) << " | " << fmt("%.1f %%", 100.0 * err.back())
+           << " | ";
+        // Studies diagnosed before the widening report the curvature interval as the 95 % one:
+        // pooled with later ones, their coverage is told apart rather than mixed in.
+        const int widened = static_cast<int>(err.size()) - notWidened;
+        if (notWidened == 0)
+            md << inside << " of " << err.size();
+        else if (widened == 0)
+            md << inside << " of " << err.size() << " (diagnosed before the widening: the curvature interval)";
+        else
+            md << inside - insideNotWidened << " of " << widened << " (and " << insideNotWidened << " of " << notWidened
+               << " diagnosed before the widening, the curvature interval)";
+        md << " | ";
+        summary["calibration"][name] = {{"sets", err.size()}, {"median_error", err[err.size() / 2]}, {"worst_error", err.back()}, {"covered", inside}};
+        if (notWidened > 0) summary["calibration"][name]["not_widened"] = {{"sets", notWidened}, {"covered", insideNotWidened}};
+        if (withCurvature > 0) {
+            const double sd = std::sqrt(std::max(0.0, excessSum / withCurvature));
+            md << insideCurvature << " of " << withCurvature << " | " << fmt("%.3g", sd) << " |\n";
+            summary["calibration"][name]["covered_by_curvature"] = insideCurvature;
+            summary["calibration_discrepancy"][name] = sd;
+        } else {
+            md << "- | - |\n";
+        }
     }
-    s.search = searchRecordOf(d, f / "diagnosis" / "diagnosis.json");
-    s.metricWeights = metricWeightsOf(d, f / "diagnosis" / "diagnosis.json");
-    s.baseline = d["gain"]["baseline"].get<double>();
-    s.final = d["gain"]["final"].get<double>();
-    s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
-    if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
-    s.beyondUsual = s.unexplained && d["unexplained_residual"].value("beyond_usual", false);
-    if (s.unexplained && d["unexplained_residual"].contains("stand_ins"))
-        for (const auto& standIn : d["unexplained_residual"]["stand_ins"]) s.standIns.push_back(standIn["effect"].get<std::string>());
-    // The set's units as its diagnosis read them (older plan.json files of newton studies do not
-    // say "units").
-    if (d.contains("calibration") && d["calibration"].contains("values") && d["calibration"]["values"].contains("scale_n_per_unit")) {
-        const std::string meaning = d["calibration"]["values"]["scale_n_per_unit"].value("meaning", "");
-        s.units = meaning.rfind("sensor scale: the set is calibrated in N", 0) == 0 ? "N" : "V";
+}
+
+/// study.csv and the summary's per-set table; returns study.json's "sets".
+json scorePerSet(const fs::path& dir, std::ostringstream& md, const std::vector<Scored>& sets)
+{
+    std::ofstream csv(dir / "study.csv");
+    csv << "set,seed,hidden,found,exact,baseline_error,final_error,unexplained,over_floor";
+    for (const auto& p : physicalParameterNames()) csv << "," << p << "_true," << p << "_found," << p << "_ci_low," << p << "_ci_high";
+    const std::vector<std::string> rigCols{"noise_n", "inharmonicity", "bridge_z0y", "headroom", "tension_error", "beta_error", "mu_level", "rod_effusivity"};
+    for (const auto& r : rigCols) csv << "," << r;
+    csv << ",study\n";
+    json perSet = json::array();
+    md << "\n| set | hidden | found | held-out error baseline -> final |\n|---|---|---|---|\n";
+    for (const auto& s : sets) {
+        std::vector<std::string> h = s.hidden, f = s.found;
+        std::sort(h.begin(), h.end());
+        std::sort(f.begin(), f.end());
+        csv << s.index << "," << s.seed << "," << effectsLabel(s.hidden) << "," << effectsLabel(s.found) << "," << (h == f) << "," << s.baseline << ","
+            << s.final << "," << s.unexplained << "," << s.overFloor;
+        for (const auto& p : physicalParameterNames()) {
+            csv << "," << (s.truth.count(p) ? fmt("%.6g", s.truth.at(p)) : "");
+            for (int k = 0; k < 3; ++k) csv << "," << (s.estimate.count(p) ? fmt("%.6g", s.estimate.at(p)[static_cast<std::size_t>(k)]) : "");
+        }
+        for (const auto& r : rigCols) csv << "," << (s.rig.count(r) ? fmt("%.6g", s.rig.at(r)) : "");
+        csv << "," << s.study << "\n";
+        std::string found = effectsLabel(s.found);
+        for (const auto& [p, v] : s.estimate) found += " " + p + fmt("=%.3g", v[0]);
+        std::string hidden = effectsLabel(s.hidden);
+        for (const auto& [p, v] : s.truth) hidden += " " + p + fmt("=%.3g", v);
+        md << "| " << (s.study.empty() ? "" : s.study + "/") << s.index << " | " << hidden << " | " << found
+           << (s.unexplained ? (s.beyondUsual ? " (+ unexplained residual, more than usual)" : " (+ unexplained residual)") : "")
+           << (s.standIns.empty() ? "" : " (possible stand-in, not named: " + effectsLabel(s.standIns) + ")") << " | "
+           << fmt("%.3f", s.baseline) << fmt(" -> %.3f", s.final) << " |\n";
+        perSet.push_back({{"set", s.index}, {"study", s.study}, {"seed", s.seed}, {"hidden", s.hidden}, {"found", s.found}, {"truth", s.truth},
+                          {"baseline_error", s.baseline}, {"final_error", s.final}, {"unexplained", s.unexplained},
+                          {"beyond_usual", s.beyondUsual}, {"stand_ins", s.standIns}, {"over_floor", s.overFloor}});
     }
-    return s;
+    return perSet;
 }
 } // namespace
 
@@ -433,156 +444,8 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
            << " of " << other << fmt(" (%.0f %%)", other ? 100.0 * fp / other : 0.0) << " | " << mde << " |\n";
         summary["detection"][e] = {{"hidden", hid}, {"named", det}, {"false_positive", fp}, {"not_hidden", other}};
     }
-    md << "\n| parameter | named sets | median error | worst error | within the issue's tolerance | truth inside the 95 % interval |\n|---|---|---|---|---|---|\n";
-    int covered = 0, intervals = 0, coveredWithoutHalves = 0, coveredStatistical = 0, coveredWithRig = 0;
-    // The model discrepancy this study measures: the spread of (found - true) beyond what the
-    // statistical and rig-unknown intervals allow, by moments (relative for r_A and zt_ratio).
-    std::map<std::string, std::pair<double, int>> excess;
-    std::map<std::string, std::pair<int, int>> coverageByStudy; ///< pooled: study -> covered, intervals
-    for (const std::string& p : physicalParameterNames()) {
-        std::vector<double> err;
-        int within = 0, inside = 0, unidentified = 0;
-        const Tolerance tol = tolerances().at(p);
-        for (const auto& s : sets) {
-            if (!s.truth.count(p) || !s.estimate.count(p) || !has(s.found, effectOfParameter(p))) continue;
-            const double t = s.truth.at(p), v = s.estimate.at(p)[0];
-            const double e = tol.relative ? std::abs(v / t - 1.0) : std::abs(v - t);
-            err.push_back(e);
-            within += e <= tol.value;
-            // An interval as wide as the search range holds any truth and says nothing: such a
-            // parameter is counted apart, not as covered.
-            if (s.unidentified.count(p)) {
-                ++unidentified;
-                continue;
-            }
-            const bool in = t >= s.estimate.at(p)[1] && t <= s.estimate.at(p)[2];
-            inside += in;
-            covered += in;
-            ++intervals;
-            coverageByStudy[s.study].first += in;
-            ++coverageByStudy[s.study].second;
-            const auto narrow = s.withoutHalves.find(p);
-            coveredWithoutHalves += narrow != s.withoutHalves.end() ? t >= narrow->second[0] && t <= narrow->second[1] : in;
-            const auto stat = s.statistical.find(p);
-            coveredStatistical += stat != s.statistical.end() ? t >= stat->second[0] && t <= stat->second[1] : in;
-            const auto rig = s.withRig.find(p);
-            coveredWithRig += rig != s.withRig.end() ? t >= rig->second[0] && t <= rig->second[1] : in;
-            if (rig != s.withRig.end()) {
-                const double unit = discrepancyIsRelative(p) ? std::abs(t) : 1.0;
-                const double sd = (rig->second[1] - rig->second[0]) / (2.0 * 1.96) / unit, miss = (v - t) / unit;
-                excess[p].first += miss * miss - sd * sd;
-                ++excess[p].second;
-            }
-        }
-        if (err.empty()) {
-            md << "| " << p << " | 0 | - | - | - | - |\n";
-            continue;
-        }
-        std::sort(err.begin(), err.end());
-        const char* unit = tol.relative ? "%.1f %%" : "%.3g";
-        const double k = tol.relative ? 100.0 : 1.0;
-        md << "| " << p << " | " << err.size() << " | " << fmt(unit, k * err[err.size() / 2]) << " | " << fmt(unit, k * err.back()) << " | "
-           << within << " (tolerance " << fmt(unit, k * tol.value) << ") | " << inside << " of " << err.size() - static_cast<std::size_t>(unidentified)
-           << (unidentified ? " (" + std::to_string(unidentified) + " not identified)" : std::string()) << " |\n";
-        summary["parameters"][p] = {{"named", err.size()}, {"median_error", err[err.size() / 2]}, {"worst_error", err.back()},
-                                    {"within_tolerance", within}, {"covered", inside}, {"not_identified", unidentified}};
-    }
-    md << fmt("\nCoverage of the 95 %% intervals over all named parameters that the data identify: %.0f %%", intervals ? 100.0 * covered / intervals : 0.0)
-       << " (" << covered << " of " << intervals << ")"
-       << fmt("; statistical part only (bootstrap, curvature, drive halves): %.0f %%", intervals ? 100.0 * coveredStatistical / intervals : 0.0)
-       << " (" << coveredStatistical << fmt("); with the rig unknowns, without the model discrepancy: %.0f %%", intervals ? 100.0 * coveredWithRig / intervals : 0.0)
-       << " (" << coveredWithRig << fmt("); bootstrap and curvature only: %.0f %%", intervals ? 100.0 * coveredWithoutHalves / intervals : 0.0)
-       << " (" << coveredWithoutHalves << ").\n";
-    // Pooled: each seed's own coverage, since the issue asks it of every study, not of the pool.
-    if (coverageByStudy.size() > 1) {
-        md << "\nBy study:";
-        const char* sep = " ";
-        for (const auto& [name, c] : coverageByStudy) {
-            md << sep << name << fmt(" %.0f %%", 100.0 * c.first / c.second) << " (" << c.first << " of " << c.second << ")";
-            summary["coverage_by_study"][name] = {{"covered", c.first}, {"intervals", c.second}};
-            sep = ", ";
-        }
-        md << ".\n";
-    }
-    md << "\nModel discrepancy this study measures (standard deviation of found - true beyond the statistical and rig-unknown intervals; "
-          "relative for r_A and zt_ratio; `rosin diagnose --model-discrepancy NAME=SD` takes it):";
-    for (const auto& [p, e] : excess) {
-        const double sd = std::sqrt(std::max(0.0, e.first / e.second));
-        md << " " << p << fmt(" %.3g", sd) << " (" << e.second << " sets);";
-        summary["model_discrepancy"][p] = sd;
-        // The raw moments too, so that studies of several seeds pool exactly:
-        // sd = sqrt(sum of excess_sum / sum of sets), clipped at 0 only once.
-        summary["model_discrepancy_moments"][p] = {{"excess_sum", e.first}, {"sets", e.second}};
-    }
-    md << "\n";
-    summary["coverage_statistical"] = intervals ? static_cast<double>(coveredStatistical) / intervals : 0.0;
-    summary["coverage_with_rig_unknowns"] = intervals ? static_cast<double>(coveredWithRig) / intervals : 0.0;
-    summary["coverage"] = intervals ? static_cast<double>(covered) / intervals : 0.0;
-    summary["coverage_without_halves"] = intervals ? static_cast<double>(coveredWithoutHalves) / intervals : 0.0;
-    // Nuisances: what the rig really was against what the diagnosis calibrated (not findings,
-    // so not in the coverage above, but their intervals should mean what they say too).
-    // Tension and bow position are 1 + the rig's relative error of the same quantity; the rod's
-    // effusivity is the rig's value over the model's nominal, which the diagnosis scales.
-    struct RigSide {
-        const char* nuisance;
-        const char* rigKey;
-        double offset, divisor;
-    };
-    const RigSide nuisanceOfRig[]{{"tension_scale", "tension_error", 1.0, 1.0},
-                                  {"beta_scale", "beta_error", 1.0, 1.0},
-                                  {"rod_effusivity_scale", "rod_effusivity", 0.0, dsp::ThermalParams{}.rodEffusivity},
-                                  {"scale_n_per_unit", "scale_n_per_unit", 0.0, 1.0}};
-    // Each fitted nuisance's discrepancy: the spread of (value - truth) beyond its curvature
-    // interval, as for the findings' parameters (what `--model-discrepancy NAME=SD` takes).
-    md << "\n| calibrated nuisance | sets | median error | worst error | truth inside the 95 % interval | inside the curvature interval alone | "
-          "discrepancy beyond the curvature (SD) |\n|---|---|---|---|---|---|---|\n";
-    for (const auto& [name, rigKey, offset, divisor] : nuisanceOfRig) {
-        std::vector<double> err;
-        int inside = 0, insideCurvature = 0, withCurvature = 0, notWidened = 0, insideNotWidened = 0;
-        double excessSum = 0.0;
-        for (const auto& s : sets) {
-            if (!s.calibration.count(name) || !s.rig.count(rigKey)) continue;
-            const double t = offset + s.rig.at(rigKey) / divisor;
-            const auto& c = s.calibration.at(name);
-            err.push_back(std::abs(c[0] / t - 1.0));
-            inside += t >= c[1] && t <= c[2];
-            if (s.calibrationNotWidened.count(name)) {
-                ++notWidened;
-                insideNotWidened += t >= c[1] && t <= c[2];
-            }
-            if (const auto k = s.calibrationCurvature.find(name); k != s.calibrationCurvature.end()) {
-                ++withCurvature;
-                insideCurvature += t >= k->second[0] && t <= k->second[1];
-                const double sd = (k->second[1] - k->second[0]) / (2.0 * 1.96);
-                excessSum += (c[0] - t) * (c[0] - t) - sd * sd;
-            }
-        }
-        if (err.empty()) continue;
-        std::sort(err.begin(), err.end());
-        md << "| " << name << " | " << err.size() << " | " << fmt("%.1f %%", 100.0 * err[err.size() / 2]) << " | " << fmt("%.1f %%", 100.0 * err.back())
-           << " | ";
-        // Studies diagnosed before the widening report the curvature interval as the 95 % one:
-        // pooled with later ones, their coverage is told apart rather than mixed in.
-        const int widened = static_cast<int>(err.size()) - notWidened;
-        if (notWidened == 0)
-            md << inside << " of " << err.size();
-        else if (widened == 0)
-            md << inside << " of " << err.size() << " (diagnosed before the widening: the curvature interval)";
-        else
-            md << inside - insideNotWidened << " of " << widened << " (and " << insideNotWidened << " of " << notWidened
-               << " diagnosed before the widening, the curvature interval)";
-        md << " | ";
-        summary["calibration"][name] = {{"sets", err.size()}, {"median_error", err[err.size() / 2]}, {"worst_error", err.back()}, {"covered", inside}};
-        if (notWidened > 0) summary["calibration"][name]["not_widened"] = {{"sets", notWidened}, {"covered", insideNotWidened}};
-        if (withCurvature > 0) {
-            const double sd = std::sqrt(std::max(0.0, excessSum / withCurvature));
-            md << insideCurvature << " of " << withCurvature << " | " << fmt("%.3g", sd) << " |\n";
-            summary["calibration"][name]["covered_by_curvature"] = insideCurvature;
-            summary["calibration_discrepancy"][name] = sd;
-        } else {
-            md << "- | - |\n";
-        }
-    }
+    scoreParameters(md, summary, sets);
+    scoreCalibration(md, summary, sets);
     // Held-out error where nothing was hidden: what a good fit reaches on this rig population.
     std::vector<double> nullBase;
     for (const auto& s : sets)
@@ -591,39 +454,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         std::sort(nullBase.begin(), nullBase.end());
         md << fmt("Null sets' final held-out error: median %.3f", nullBase[nullBase.size() / 2]) << fmt(", worst %.3f.\n", nullBase.back());
     }
-    // Per set.
-    std::ofstream csv(dir / "study.csv");
-    csv << "set,seed,hidden,found,exact,baseline_error,final_error,unexplained,over_floor";
-    for (const auto& p : physicalParameterNames()) csv << "," << p << "_true," << p << "_found," << p << "_ci_low," << p << "_ci_high";
-    const std::vector<std::string> rigCols{"noise_n", "inharmonicity", "bridge_z0y", "headroom", "tension_error", "beta_error", "mu_level", "rod_effusivity"};
-    for (const auto& r : rigCols) csv << "," << r;
-    csv << ",study\n";
-    json perSet = json::array();
-    md << "\n| set | hidden | found | held-out error baseline -> final |\n|---|---|---|---|\n";
-    for (const auto& s : sets) {
-        std::vector<std::string> h = s.hidden, f = s.found;
-        std::sort(h.begin(), h.end());
-        std::sort(f.begin(), f.end());
-        csv << s.index << "," << s.seed << "," << effectsLabel(s.hidden) << "," << effectsLabel(s.found) << "," << (h == f) << "," << s.baseline << ","
-            << s.final << "," << s.unexplained << "," << s.overFloor;
-        for (const auto& p : physicalParameterNames()) {
-            csv << "," << (s.truth.count(p) ? fmt("%.6g", s.truth.at(p)) : "");
-            for (int k = 0; k < 3; ++k) csv << "," << (s.estimate.count(p) ? fmt("%.6g", s.estimate.at(p)[static_cast<std::size_t>(k)]) : "");
-        }
-        for (const auto& r : rigCols) csv << "," << (s.rig.count(r) ? fmt("%.6g", s.rig.at(r)) : "");
-        csv << "," << s.study << "\n";
-        std::string found = effectsLabel(s.found);
-        for (const auto& [p, v] : s.estimate) found += " " + p + fmt("=%.3g", v[0]);
-        std::string hidden = effectsLabel(s.hidden);
-        for (const auto& [p, v] : s.truth) hidden += " " + p + fmt("=%.3g", v);
-        md << "| " << (s.study.empty() ? "" : s.study + "/") << s.index << " | " << hidden << " | " << found
-           << (s.unexplained ? (s.beyondUsual ? " (+ unexplained residual, more than usual)" : " (+ unexplained residual)") : "")
-           << (s.standIns.empty() ? "" : " (possible stand-in, not named: " + effectsLabel(s.standIns) + ")") << " | "
-           << fmt("%.3f", s.baseline) << fmt(" -> %.3f", s.final) << " |\n";
-        perSet.push_back({{"set", s.index}, {"study", s.study}, {"seed", s.seed}, {"hidden", s.hidden}, {"found", s.found}, {"truth", s.truth},
-                          {"baseline_error", s.baseline}, {"final_error", s.final}, {"unexplained", s.unexplained},
-                          {"beyond_usual", s.beyondUsual}, {"stand_ins", s.standIns}, {"over_floor", s.overFloor}});
-    }
+    const json perSet = scorePerSet(dir, md, sets);
     if (pooled) {
         json from = json::array();
         for (const fs::path& study : studies) from.push_back(study.filename().string());
