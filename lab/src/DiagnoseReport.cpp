@@ -314,6 +314,14 @@ std::string metricInWords(const std::array<double, 5>& w)
     return buf;
 }
 
+/// "0.25, 0.25, 0.25, 0.1<last>0.15": the weights for report.md's sentence.
+std::string weightList(const std::array<double, 5>& w, const char* last)
+{
+    std::string out;
+    for (std::size_t k = 0; k < w.size(); ++k) out += (k == 0 ? "" : k + 1 == w.size() ? last : ", ") + fmt(w[k]);
+    return out;
+}
+
 std::string effectList(const std::vector<Finding>& list)
 {
     std::string out;
@@ -592,10 +600,10 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
           "final model against itself with 1 % scatter of force and acceleration on the test strokes. "
        << (defaultMetricWeights(o.metricWeights)
                ? std::string()
-               : "The metric ran with other weights than its own (" + fmt(o.metricWeights[0]) + ", " + fmt(o.metricWeights[1]) + ", " +
-                     fmt(o.metricWeights[2]) + ", " + fmt(o.metricWeights[3]) + ", " + fmt(o.metricWeights[4]) +
+               : "The metric ran with other weights than its own (" + weightList(o.metricWeights, ", ") +
                      " for first-slip time, force before it, jump, transient length and waveform); the naming threshold and the "
-                     "model discrepancies were measured with 0.25, 0.25, 0.25, 0.1 and 0.15, so what this run names is not calibrated. ")
+                     "model discrepancies were measured with " + weightList(ErrorParts::kWeights, " and ") +
+                     ", so what this run names is not calibrated. ")
        << d.simulations << " simulations in " << fmt(d.seconds, "%.1f") << " s.\n";
     for (const auto& w : d.warnings) md << "\nWarning: " << w << "\n";
 }

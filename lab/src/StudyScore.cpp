@@ -16,7 +16,6 @@
 #include "StudyScored.h"
 #include "rosin/dsp/FrictionLaws.h"
 #include "rosin/lab/Error.h"
-#include "rosin/lab/Plot.h"
 #include "rosin/lab/Study.h"
 #include "rosin/lab/SynthData.h"
 
