@@ -9,6 +9,7 @@
 #include <atomic>
 #include <functional>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -17,6 +18,7 @@
 
 #include "rosin/dsp.h"
 #include "rosin/lab/Diagnose.h"
+#include "rosin/lab/Guettler.h"
 #include "rosin/lab/Measurement.h"
 
 namespace rosin::lab::diag {
@@ -372,5 +374,18 @@ Residual measureResidual(const Engine& engine, const EffectModel& current, const
 std::size_t setAsideStandIns(Diagnosis& d);
 /// Rule 6 in words, with the usual ratio it applies beyond, for the report's rules.
 std::string standInRuleText(double usualRatio);
+
+/// The Guettler maps of the gesture a diagnosis shows (its Guettler strokes when it has them, else
+/// its commonest kind), as report.md describes them.
+struct ShownMaps {
+    std::string gesture;
+    SweepResult measured, baseline, final;
+};
+
+/// maps.png, overlays.png, jumps.png and strokes.csv (the maps' data) into dir.
+ShownMaps writeStrokeFigures(const std::filesystem::path& dir, const Diagnosis& d);
+
+/// loops.png: each two-ended stroke's friction against bow-point velocity, measured and final.
+void writeLoopsFigure(const std::filesystem::path& file, const Diagnosis& d);
 
 } // namespace rosin::lab::diag
