@@ -203,10 +203,10 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         std::vector<Tried> tried;
         const double valBefore = mean(currentVal);
         // The candidate's validation errors, its paired gain and its trial row with rule 1's verdict.
-        auto evaluate = [&](const Candidate& c, std::vector<double> x, double fitError, std::uint64_t split) {
+        auto evaluate = [&](const Candidate& c, std::vector<double> x, double fitError, std::uint64_t bootstrapStream) {
             Tried t{c, std::move(x), {}, {}, d.trials.size()};
             t.val = engine.errors(apply(current, c, t.x), valSet);
-            t.gain = pairedGain(currentVal, t.val, o.bootstrap, o.seed + split);
+            t.gain = pairedGain(currentVal, t.val, o.bootstrap, o.seed + bootstrapStream);
             Trial trial;
             trial.round = round;
             trial.effect = c.effect;
@@ -292,12 +292,12 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                     resampled.push_back(fitSet[at]);
                     estimateOnResample.push_back(estimateOnFit[at]);
                 }
-                std::vector<double> start = t.x;
-                for (std::size_t k = 0; k < start.size(); ++k)
-                    start[k] = std::clamp(start[k] + jump(prng) * (t.c.hi[k] - t.c.lo[k]), t.c.lo[k], t.c.hi[k]);
+                std::vector<double> freshStart = t.x;
+                for (std::size_t k = 0; k < freshStart.size(); ++k)
+                    freshStart[k] = std::clamp(freshStart[k] + jump(prng) * (t.c.hi[k] - t.c.lo[k]), t.c.lo[k], t.c.hi[k]);
                 const int evaluations = std::max(8, o.maxEvaluations / 2);
                 double refitError = 0.0;
-                std::vector<double> refit = diag::fit(engine, current, t.c, resampled, start, evaluations, 0.1, &refitError, false);
+                std::vector<double> refit = diag::fit(engine, current, t.c, resampled, freshStart, evaluations, 0.1, &refitError, false);
                 // A refit that ends worse on its own resample than the estimate has not converged
                 // (a few COBYLA steps for five or more parameters): search again from the estimate.
                 if (mean(estimateOnResample) < refitError)
@@ -424,12 +424,12 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                 // there). The winner is new this round, so the model without the earlier effect
                 // offers it. A pair's further start from its two parts is not repeated: its parts
                 // were fitted beside the earlier effect.
-                const EffectModel before = removed(earlier, effect);
-                const auto winner = offered(before, best->c.effect);
+                const EffectModel withoutEarlier = removed(earlier, effect);
+                const auto winner = offered(withoutEarlier, best->c.effect);
                 if (!winner) continue;
-                const Candidate c = withNuisances(*winner, before);
+                const Candidate c = withNuisances(*winner, withoutEarlier);
                 double fitError = 0.0;
-                Without w{effect, apply(before, c, search(before, c, fitError)), {}, 0.0};
+                Without w{effect, apply(withoutEarlier, c, search(withoutEarlier, c, fitError)), {}, 0.0};
                 w.val = engine.errors(w.model, valSet);
                 w.share = relativeFall(mean(w.val), mean(currentVal));
                 tested.push_back(std::move(w));

@@ -169,7 +169,11 @@ SteadyFitResult fitSteadySliding(const std::vector<SteadySlidingPoint>& pts)
 StringInfo stringInfoOf(const MeasurementSet& set)
 {
     const dsp::StringParams ref = dsp::StringParams::celloD();
-    StringInfo info{set.f0, set.beta, 0, set.tension.value_or(ref.tension), set.length.value_or(ref.length)};
+    StringInfo info;
+    info.f0 = set.f0;
+    info.beta = set.beta;
+    info.tension = set.tension.value_or(ref.tension);
+    info.length = set.length.value_or(ref.length);
     info.z0 = set.z0.value_or(info.tension / (2.0 * info.length * info.f0));
     info.tensionPrior = set.tensionUncertainty;
     info.betaPrior = set.betaUncertainty;

@@ -103,7 +103,11 @@ std::string nuisanceMeaning(const std::string& p)
 /// A candidate whose parameters take their bounds from parameterBounds().
 Candidate candidate(const std::string& effect, std::vector<std::string> names, std::vector<double> start)
 {
-    Candidate c{effect, {effect}, std::move(names), {}, {}, std::move(start)};
+    Candidate c;
+    c.effect = effect;
+    c.adds = {effect};
+    c.names = std::move(names);
+    c.start = std::move(start);
     for (const auto& name : c.names) {
         c.lo.push_back(parameterBounds().at(name).first);
         c.hi.push_back(parameterBounds().at(name).second);

@@ -24,7 +24,7 @@
 namespace rosin::lab::diag {
 
 struct StringInfo {
-    double f0, beta, z0, tension, length;
+    double f0 = 0, beta = 0, z0 = 0, tension = 0, length = 0;
     /// The manifest's stated priors of tension and bow position (a fraction either way); unset:
     /// parameterBounds()'s.
     std::optional<double> tensionPrior, betaPrior;

@@ -129,7 +129,8 @@ std::string describeMetricWeights(const std::array<double, 5>& weights)
     char buf[32];
     for (double x : weights) {
         std::snprintf(buf, sizeof buf, "%g", x);
-        text += (text.empty() ? "" : "/") + std::string(buf);
+        if (!text.empty()) text += '/';
+        text += buf;
     }
     return text + (defaultMetricWeights(weights) ? " (the default)" : "");
 }

@@ -440,7 +440,9 @@ TEST(HidUdev, EveryProfileHasItsLineAndNoOtherDeviceMatches)
     }
     for (const auto& d : supportedDevices()) {
         EXPECT_EQ(matching(d.vendor, d.product, d.bus, "hidraw"), 1) << d.name;
-        if (d.bus == Bus::Usb) EXPECT_EQ(matching(d.vendor, d.product, d.bus, "usb"), 1) << d.name << " (USB strings)";
+        if (d.bus == Bus::Usb) {
+            EXPECT_EQ(matching(d.vendor, d.product, d.bus, "usb"), 1) << d.name << " (USB strings)";
+        }
     }
     // Devices of the same vendors with no profile: a receiver, keyboards, another tablet, a newer
     // pad; and a supported pad on a bus it is not listed for.

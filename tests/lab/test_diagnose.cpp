@@ -165,7 +165,9 @@ void check(const Case& k)
     // rig unknown's); a named torsion has taken its own softening into the value instead.
     const bool roomForARoll = scale->meaning.find("a roll of Z_t/Z_0 = 2 that no model named") != std::string::npos;
     EXPECT_EQ(roomForARoll, !torsion) << scale->meaning;
-    if (!torsion) EXPECT_LE(scale->low, d.scale * diag::softeningAt(diag::kReadilyRollingZt) * (1.0 + 1e-12));
+    if (!torsion) {
+        EXPECT_LE(scale->low, d.scale * diag::softeningAt(diag::kReadilyRollingZt) * (1.0 + 1e-12));
+    }
 }
 } // namespace
 
@@ -973,7 +975,9 @@ TEST(DiagnoseCalibration, StatedTorsionalConstantsAreTheOnesARollPlays)
         if (speed) {
             EXPECT_EQ(c.string.torsionSpeedRatio, *speed);
             EXPECT_EQ(c.string.qTorsion, *q);
-            if (c.waveguide.torsion) EXPECT_NEAR(diag::rollingSoftening(c), diag::softeningAt(1.6, speed), 1e-12);
+            if (c.waveguide.torsion) {
+                EXPECT_NEAR(diag::rollingSoftening(c), diag::softeningAt(1.6, speed), 1e-12);
+            }
         }
         std::vector<double> e;
         for (const auto& x : engine.errors(m, all)) e.push_back(x.total());

@@ -80,7 +80,9 @@ TEST(ReferenceConduction, ConstantFluxIntoTwoStationarySidesIsExact)
         c.prepare(h, es, er, recent);
         for (int n = 1; n <= 20000; ++n) {
             const double theta = c.step(q, 0.0, 0.0, 0.0);
-            if (n % 2500 == 0) EXPECT_NEAR(theta / (2 * q * std::sqrt(n * h / kPi) / (es + er)), 1.0, 1e-11) << n << " steps, recent " << recent;
+            if (n % 2500 == 0) {
+                EXPECT_NEAR(theta / (2 * q * std::sqrt(n * h / kPi) / (es + er)), 1.0, 1e-11) << n << " steps, recent " << recent;
+            }
         }
     }
 }
@@ -95,7 +97,9 @@ TEST(ReferenceConduction, RenewedSideFollowsTheErfSolution)
     for (int n = 1; n <= 40000; ++n) {
         const double theta = c.step(q, 0.0, 0.0, kappa);
         const double exact = q * std::erf(std::sqrt(kappa * n * h)) / (er * std::sqrt(kappa));
-        if (n % 4000 == 0) EXPECT_NEAR(theta / exact, 1.0, 4e-5) << n << " steps";
+        if (n % 4000 == 0) {
+            EXPECT_NEAR(theta / exact, 1.0, 4e-5) << n << " steps";
+        }
     }
 }
 

@@ -139,7 +139,9 @@ TEST(EnhancedModel, FirstSlipJumpsAboveTheThresholdForceAndNotBelow)
             const int n1 = firstSlip(fr);
             ASSERT_GT(n1, 0);
             const double jump = std::abs(fr[n1].friction - fr[n1 - 1].friction) / force;
-            if (ratio > 1) EXPECT_GT(jump, 0.02) << "torsion=" << torsion;
+            if (ratio > 1) {
+                EXPECT_GT(jump, 0.02) << "torsion=" << torsion;
+            }
             else EXPECT_LT(jump, 0.002) << "torsion=" << torsion;
         }
     }
