@@ -20,8 +20,8 @@ juce::Label* RosinLook::createSliderTextBox(juce::Slider& s)
     return l;
 }
 
-RosinEditor::RosinEditor(plugin::RosinProcessor& processor)
-    : AudioProcessorEditor(processor), processor_(processor), views_(processor)
+RosinEditor::RosinEditor(plugin::RosinProcessor& owner)
+    : AudioProcessorEditor(owner), processor_(owner), views_(owner)
 {
     setLookAndFeel(&look_);
     title_.setText("Rosin", juce::dontSendNotification);

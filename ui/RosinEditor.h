@@ -28,7 +28,7 @@ public:
 
 class RosinEditor : public juce::AudioProcessorEditor, private juce::Timer, private juce::MidiKeyboardState::Listener {
 public:
-    explicit RosinEditor(plugin::RosinProcessor& processor);
+    explicit RosinEditor(plugin::RosinProcessor& owner);
     ~RosinEditor() override;
     void resized() override;
     void paint(juce::Graphics& g) override;

@@ -138,9 +138,12 @@ bool selfTest() noexcept
     rosin_audit_scope(1);
     void* volatile p = std::malloc(64);
     std::free(p);
-    pthread_mutex_t m = PTHREAD_MUTEX_INITIALIZER;
+    // Set up before the counted calls (glibc's PTHREAD_MUTEX_INITIALIZER spells a null as 0).
+    pthread_mutex_t m;
+    pthread_mutex_init(&m, nullptr);
     pthread_mutex_lock(&m);
     pthread_mutex_unlock(&m);
+    pthread_mutex_destroy(&m);
     pthread_cond_t c = PTHREAD_COND_INITIALIZER;
     pthread_cond_signal(&c);
     const struct timespec zero{0, 0};

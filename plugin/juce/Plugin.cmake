@@ -36,6 +36,12 @@ target_compile_definitions(RosinPlugin PUBLIC ${ROSIN_JUCE_DEFINITIONS}
 target_link_libraries(RosinPlugin
   PRIVATE rosin::engine rosin::hid rosin_lab_core juce::juce_audio_utils juce::juce_audio_plugin_client ${CMAKE_DL_LIBS}
   PUBLIC juce::juce_recommended_config_flags juce::juce_recommended_warning_flags)
+# GCC 12 takes JUCE 7.0.5's ListenerList iterator, which links itself into the list and unlinks in
+# its destructor, for a dangling pointer in every JUCE module compiled here; and the dsp headers'
+# four-double vectors draw the AVX calling-convention note (see the top-level CMakeLists.txt).
+foreach(target RosinPlugin RosinPlugin_VST3 RosinPlugin_LV2 RosinPlugin_Standalone)
+  target_compile_options(${target} PRIVATE -Wno-dangling-pointer -Wno-psabi)
+endforeach()
 
 # Debian JUCE 7.0.5 quirk: enumerated LV2 parameters get normalised scale points (see the script).
 get_target_property(ROSIN_LV2_DIR RosinPlugin_LV2 LIBRARY_OUTPUT_DIRECTORY)

@@ -264,7 +264,8 @@ TEST(GuettlerBounds, ADiagramOfAnEmptySweepIsRefused)
 {
     const std::filesystem::path file = std::filesystem::temp_directory_path() / ("rosin-empty-sweep-" + std::to_string(::getpid()) + ".png");
     std::filesystem::remove(file);
-    EXPECT_THROW(rosin::lab::writePanelPng(file, {rosin::lab::SweepResult{}}, {"empty"}, 1, rosin::lab::DiagramOptions{}), rosin::lab::LabError);
+    const std::vector<rosin::lab::SweepResult> empty(1);
+    EXPECT_THROW(rosin::lab::writePanelPng(file, empty, {"empty"}, 1, rosin::lab::DiagramOptions{}), rosin::lab::LabError);
     rosin::lab::SweepResult partial;
     partial.spec.accelerations = {0.5, 1.0};
     partial.spec.forces = {0.2, 0.4};

@@ -250,7 +250,8 @@ TEST(Reference, ConvergesUnderRefinement)
         rig.string.torsionSpeedRatio = 5.0;
         rig.bridge.push_back({1500, 15, 0.05});
         rig.friction.law = reference::FrictionLaw::Thermal;
-        Run r{c * cells / kL};
+        Run r;
+        r.fs = c * cells / kL;
         reference::Simulator s(rig, 0.09, r.fs);
         ASSERT_EQ(s.grid().cells, cells);
         for (int i = 0; i < static_cast<int>(0.056 * r.fs); ++i) {

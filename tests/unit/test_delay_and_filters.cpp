@@ -32,8 +32,9 @@ TEST(DelayLine, EveryDelayReadsTheRightSampleThroughWraps)
             ASSERT_EQ(line.read(static_cast<double>(d)), static_cast<float>(n - d)) << "delay " << d << " at " << n;
             const auto t = line.tap(static_cast<double>(d) + 0.5);
             const float* p = line.stencil(t); // oldest first: delays base + 3 .. base
-            if (n >= static_cast<int>(t.base) + 3)
+            if (n >= static_cast<int>(t.base) + 3) {
                 for (int k = 0; k < 4; ++k) ASSERT_EQ(p[k], static_cast<float>(n - static_cast<int>(t.base) - 3 + k));
+            }
         }
         line.write(static_cast<float>(n));
     }

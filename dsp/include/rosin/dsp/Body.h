@@ -98,7 +98,8 @@ public:
 private:
     BodyParams params_;
     // Plain arrays: GCC drops the vector attribute inside std::array.
-    Pack g_[maxPacks]{}, k_[maxPacks]{}, a1_[maxPacks]{}, gain_[maxPacks]{}, ic1_[maxPacks]{}, ic2_[maxPacks]{};
+    static constexpr auto packSlots = static_cast<std::size_t>(maxPacks);
+    Pack g_[packSlots]{}, k_[packSlots]{}, a1_[packSlots]{}, gain_[packSlots]{}, ic1_[packSlots]{}, ic2_[packSlots]{};
     T direct_ = T(0.2), scale_ = T(1);
     int active_ = 0, packs_ = 0;
 };

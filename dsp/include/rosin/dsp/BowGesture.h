@@ -127,6 +127,7 @@ public:
         }
         case Articulation::Detache:
         case Articulation::Harmonic: // bowed like detache; the left hand makes the harmonic
+        case Articulation::Count:    // not an articulation: a stray value plays as detache
         default: {
             if (speedMag_ < aim.speed) speedMag_ = std::min(aim.speed, speedMag_ + settings_.acceleration * std::max(0.05, velocity_) * dt);
             else speedMag_ += (aim.speed - speedMag_) * settle10ms_;

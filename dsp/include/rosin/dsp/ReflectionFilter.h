@@ -171,7 +171,7 @@ template <typename T, int MaxSections = 8>
 struct DispersionChain {
     int sections = 0;
     T a = T(0);
-    std::array<T, MaxSections> xPrev{}, yPrev{};
+    std::array<T, static_cast<std::size_t>(MaxSections)> xPrev{}, yPrev{};
 
     static double sectionPhaseDelay(double a, double w) noexcept
     {

@@ -50,12 +50,12 @@ public:
             values.push_back(valueAt(fit, speed, v));
         }
         thetaMax_ = thetas.back();
-        const int m = config::temperatureTableSize;
+        const auto m = static_cast<std::size_t>(config::temperatureTableSize);
         table_.assign(m, 0.0);
-        step_ = thetaMax_ / (m - 1);
+        step_ = thetaMax_ / static_cast<double>(m - 1);
         std::size_t j = 0;
-        for (int i = 0; i < m; ++i) {
-            const double th = i * step_;
+        for (std::size_t i = 0; i < m; ++i) {
+            const double th = static_cast<double>(i) * step_;
             while (j + 2 < thetas.size() && thetas[j + 1] < th) ++j;
             const double t0 = thetas[j], t1 = thetas[j + 1];
             const double s = std::clamp((th - t0) / (t1 - t0), 0.0, 1.0);
@@ -68,7 +68,7 @@ public:
         tableLast_ = table_.back();
         segments_.assign(m - 1, Segment{});
         nonIncreasing_ = true;
-        for (int i = 0; i + 1 < m; ++i) {
+        for (std::size_t i = 0; i + 1 < m; ++i) {
             segments_[i] = {table_[i], table_[i + 1] - table_[i]};
             nonIncreasing_ = nonIncreasing_ && segments_[i].rise <= 0.0;
         }

@@ -279,8 +279,9 @@ private:
     std::vector<RenewalEntry> renewal_;
     std::array<double, N> xi_{}, weight_{}, baseDecay_{};
     // Plain arrays: GCC drops the vector attribute of Pack inside std::array<Pack, ...>.
-    Pack z_[kPacks]{}, decay_[kPacks]{}, gain_[kPacks]{}, historyDecay_[kPacks]{};
-    Pack xiT_[kPacks]{}, weightT_[kPacks]{}, weightXiDecayT_[kPacks]{}, baseDecayT_[kPacks]{};
+    static constexpr auto kPackSlots = static_cast<std::size_t>(kPacks);
+    Pack z_[kPackSlots]{}, decay_[kPackSlots]{}, gain_[kPackSlots]{}, historyDecay_[kPackSlots]{};
+    Pack xiT_[kPackSlots]{}, weightT_[kPackSlots]{}, weightXiDecayT_[kPackSlots]{}, baseDecayT_[kPackSlots]{};
     T renewalDecay_ = T(1); // exp(-kappa h) of the coefficients in use
 };
 
