@@ -412,7 +412,7 @@ TEST(Study, ANewtonStudyWritesItsSetsInNewtonsAndItsPlanSaysSo)
 {
     const fs::path volts = freshDir("units-v"), newtons = freshDir("units-n");
     StudyOptions o = madeOnly(1, 1, 13);
-    const auto [planV, planN] = studiesBeforeAndAfter(volts, newtons, o, [](StudyOptions& x) { x.units = "N"; }, "a volt study resumed in newtons");
+    const auto [planV, planN] = studiesBeforeAndAfter(volts, newtons, o, [](StudyOptions& x) { x.units = std::string("N"); }, "a volt study resumed in newtons");
     EXPECT_FALSE(planV.contains("units")) << "volt plans stay as earlier studies wrote them";
     EXPECT_EQ(planN["units"], "N");
     json tv, tn;
