@@ -9,6 +9,7 @@
 #include <atomic>
 #include <functional>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -53,6 +54,14 @@ constexpr double kCompareCutoff = 5000.0; // both signals see the same low-pass 
 /// Classifier input for a stroke of gesture g on string s: the bow speed follows the gesture, and
 /// a rising-force stroke (which slides from the start) gives the shape of its pre-slip force.
 ClassifierInput strokeInput(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s);
+/// x printed with the printf format f, for the report's sentences and tables and the figures' data.
+inline std::string fmt(double x, const char* f = "%.3g")
+{
+    char b[64];
+    std::snprintf(b, sizeof b, f, x);
+    return b;
+}
+
 /// Noise of a low-passed recording: the robust spread of its sample-to-sample steps.
 double noiseLevel(const std::vector<double>& f);
 /// Features of a stroke's force f. A first slip must drop the force within 0.1 ms by 2 % of the bow

@@ -119,13 +119,6 @@ void jumps(const fs::path& file, const Diagnosis& d)
     canvas.save(file);
 }
 
-std::string fmt(double x, const char* f)
-{
-    char b[64];
-    std::snprintf(b, sizeof b, f, x);
-    return b;
-}
-
 // The data of maps.png: every stroke's place, role in the split, features as recorded and as the
 // baseline and the final model play it, and its disagreement part by part (uncapped parts are
 // not kept: the metric caps each at 1).

@@ -14,17 +14,7 @@
 namespace rosin::lab {
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-namespace {
-
-std::string fmt(double x, const char* f = "%.3g")
-{
-    char b[64];
-    std::snprintf(b, sizeof b, f, x);
-    return b;
-}
-
-} // namespace
+using diag::fmt;
 
 namespace diag {
 
