@@ -337,7 +337,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         if (!d.standIns.empty()) {
             md << "### Possible stand-ins (not named)\n\nThe rounds named " << effectList(d.standIns) << " under rules 1-5, and the final model's "
                << "error and the residual above are measured with " << (d.standIns.size() > 1 ? "them" : "it") << " in. But with a residual "
-               << "beyond the usual one the model lacks something here, and a further bend of the thermal law (a rate law, a rosin "
+               << "beyond the usual one the model may lack something here, and a further bend of the thermal law (a rate law, a rosin "
                << "shift) or a rolling string can take the place of what it lacks (on strings ten times stiffer than the studies' "
                << "stiffest, +23 to +25 K shifts and a torsion were fitted where rate laws were hidden). So " << (d.standIns.size() > 1 ? "they are" : "it is")
                << " not named (rule 6): what would be named, and where the fits put it:\n\n| effect | parameter | value | 95 % CI (reported) |\n|---|---|---|---|\n";

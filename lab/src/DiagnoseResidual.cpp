@@ -14,14 +14,24 @@ namespace rosin::lab::diag {
 
 std::string usualResidualText(const Residual& r)
 {
-    char buf[400];
+    // The usual residual is the largest of a study's null rigs, so a fresh ordinary rig passes it
+    // now and then (3 of 40 fresh nulls; over the ~110 of the fresh verdicts by up to 20 %, none by
+    // 30 %). Only beyond that margin does the wording claim the rig has something more.
+    constexpr double firmlyBeyond = 1.3;
+    const char* verdict = r.ratio > firmlyBeyond * r.usual
+                              ? "more than the model's usual difference from a real string, by more than any rig with nothing hidden "
+                                "has shown: something on this rig the model lacks"
+                          : r.ratio > r.usual
+                              ? "a little more than the model's usual difference from a real string (ordinary rigs with nothing hidden "
+                                "pass that bound now and then, by up to 20 % on the studies' fresh null sets): a hint that this rig has something "
+                                "the model lacks, not a finding"
+                              : "within the model's usual difference from a real string, and says no more than that";
+    char buf[700];
     if (r.usual <= 0.0) return "no usual residual was given to compare it with";
     std::snprintf(buf, sizeof buf,
                   "on the study's reference rigs with nothing hidden (strings, bridges and sensors that differ from the model's as a "
                   "lab's usually do) the final error stayed within %.1f times the floor, so %.1f times is %s",
-                  r.usual, r.ratio,
-                  r.ratio > r.usual ? "more than the model's usual difference from a real string: something on this rig the model lacks"
-                                    : "within the model's usual difference from a real string, and says no more than that");
+                  r.usual, r.ratio, verdict);
     return buf;
 }
 
@@ -142,7 +152,7 @@ std::string standInRuleText(double usualRatio)
     char usual[32];
     std::snprintf(usual, sizeof usual, "%.3g", usualRatio);
     return "(6) When the final model leaves a residual beyond the usual one (more than " + std::string(usual) +
-           " times the set's floor), the model lacks something on this rig, and a rate dependence or a rosin shift (a further "
+           " times the set's floor), the model may lack something on this rig, and a rate dependence or a rosin shift (a further "
            "bend of the thermal law) or a rolling string (a softer bow point) can stand in for it: those are reported as possible "
            "stand-ins with their parameters, not as findings, while thermal memory and a contact law stay named.";
 }

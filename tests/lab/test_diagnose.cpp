@@ -313,6 +313,28 @@ TEST(DiagnoseParameters, AShiftThatFlipsSignBesideARateLawIsAStandIn)
     EXPECT_FALSE(diag::shiftFlippedBesideRateLaw({trial(2, "rosin_temperature_shift", 24.0)}, -20.0)); // no round-1 candidate
 }
 
+// The usual residual is the largest of a study's nulls, which fresh nulls pass by up to 20 %: the
+// report calls a residual just beyond it a hint, and only one past 1.3 times it something the rig has.
+TEST(DiagnoseResidualText, JustBeyondTheUsualResidualIsAHintAndFarBeyondItAFinding)
+{
+    Residual r;
+    r.usual = 8.6;
+    const auto says = [&](double ratio) {
+        r.ratio = ratio;
+        return diag::usualResidualText(r);
+    };
+    const std::string within = says(8.0), hint = says(9.7), firm = says(11.5), edge = says(11.1);
+    EXPECT_NE(within.find("within the model's usual difference"), std::string::npos) << within;
+    EXPECT_NE(hint.find("a hint that this rig has something the model lacks, not a finding"), std::string::npos) << hint;
+    EXPECT_EQ(hint.find("something on this rig the model lacks"), std::string::npos) << hint;
+    EXPECT_NE(hint.find("8.6 times the floor, so 9.7 times"), std::string::npos) << hint;
+    EXPECT_NE(firm.find("something on this rig the model lacks"), std::string::npos) << firm;
+    EXPECT_EQ(firm.find("a hint"), std::string::npos) << firm;
+    EXPECT_NE(edge.find("a hint"), std::string::npos) << "11.1 is under 1.3 x 8.6 = 11.18: " << edge;
+    r.usual = 0.0;
+    EXPECT_EQ(says(30.0), "no usual residual was given to compare it with");
+}
+
 // A later round's torsion candidate is searched also from round 1's Z_t/Z_0 (the rest of the start
 // as the model has it), and only when round 1 fitted some torsion on the baseline.
 // Rule 6: beside a residual beyond the usual one, a rate law, a rosin shift and a torsion are set
