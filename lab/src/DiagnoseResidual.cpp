@@ -14,11 +14,9 @@ namespace rosin::lab::diag {
 
 std::string usualResidualText(const Residual& r)
 {
-    // The usual residual is the largest of a study's null rigs, so a fresh ordinary rig passes it
-    // now and then (3 of 40 fresh nulls; over the ~110 of the fresh verdicts by up to 20 %, none by
-    // 30 %). Only beyond that margin does the wording claim the rig has something more.
-    constexpr double firmlyBeyond = 1.3;
-    const char* verdict = r.ratio > firmlyBeyond * r.usual
+    // Only past kFirmlyBeyondUsual (Diagnose.h says why) does the wording claim the rig has
+    // something the model lacks.
+    const char* verdict = r.ratio > kFirmlyBeyondUsual * r.usual
                               ? "more than the model's usual difference from a real string, by more than any rig with nothing hidden "
                                 "has shown: something on this rig the model lacks"
                           : r.ratio > r.usual

@@ -338,11 +338,14 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     md << "Sets named exactly right (every hidden effect and nothing else): " << exact << " of " << sets.size() << ".\n";
     md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
     // What the models on the list could not explain, and how far above the sets' own floors.
-    int residuals = 0, nullResiduals = 0, beyondUsual = 0;
+    int residuals = 0, nullResiduals = 0, beyondUsual = 0, nullBeyondUsual = 0, firmlyBeyond = 0, nullFirmlyBeyond = 0;
     std::vector<double> overFloor;
     for (const auto& s : sets) {
         residuals += s.unexplained;
         beyondUsual += s.beyondUsual;
+        nullBeyondUsual += s.beyondUsual && s.hidden.empty();
+        firmlyBeyond += s.firmlyBeyondUsual;
+        nullFirmlyBeyond += s.firmlyBeyondUsual && s.hidden.empty();
         nullResiduals += s.unexplained && s.hidden.empty();
         overFloor.push_back(s.overFloor);
     }
@@ -350,7 +353,9 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     md << "Unexplained residual reported on " << residuals << " of " << sets.size() << " sets (" << nullResiduals << " of the " << nNull
        << " null sets); final error over the set's floor: median " << fmt("%.2f", overFloor[overFloor.size() / 2])
        << fmt(", from %.2f", overFloor.front()) << fmt(" to %.2f", overFloor.back()) << "; more than the usual residual on " << beyondUsual
-       << " of " << sets.size() << ".\n";
+       << " of " << sets.size() << " (" << nullBeyondUsual << " null), and more than " << fmt("%.2g", kFirmlyBeyondUsual)
+       << " times it, where the report says the rig has something the model lacks, on " << firmlyBeyond << " (" << nullFirmlyBeyond
+       << " null).\n";
     // The usual residual: what the model leaves where nothing is hidden, on this rig population.
     double usual = 0;
     for (const auto& s : sets)
@@ -399,7 +404,13 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     }
     md << "\n";
     summary["unexplained_residual"] = {
-        {"sets", residuals}, {"null_sets", nullResiduals}, {"beyond_usual", beyondUsual}, {"median_over_floor", overFloor[overFloor.size() / 2]}};
+        {"sets", residuals},
+        {"null_sets", nullResiduals},
+        {"beyond_usual", beyondUsual},
+        {"null_beyond_usual", nullBeyondUsual},
+        {"firmly_beyond_usual", firmlyBeyond},
+        {"null_firmly_beyond_usual", nullFirmlyBeyond},
+        {"median_over_floor", overFloor[overFloor.size() / 2]}};
     summary["stand_ins"] = {{"sets", standInSets}, {"not_hidden", standInsNotHidden}, {"hidden", standInsHidden}};
     summary["sets"] = sets.size();
     summary["split_method"] = splitSeen.first;

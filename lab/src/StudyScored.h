@@ -51,6 +51,7 @@ struct Scored {
     double baseline = 0, final = 0;
     bool unexplained = false;
     bool beyondUsual = false;  ///< the residual is above the usual ratio the diagnosis compared it with
+    bool firmlyBeyondUsual = false; ///< ... and above kFirmlyBeyondUsual times it (the report's "the rig has something the model lacks")
     std::vector<std::string> standIns; ///< effects set aside beside a residual beyond the usual one (rule 6): not named
     double overFloor = 0;      ///< the final error over the set's noise-and-chaos floor
     std::string units;         ///< "V" or "N" as the diagnosis read the set ("" when it does not say)

@@ -603,7 +603,8 @@ TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
 // rod effusivity over 450 (only sets with a thermal model calibrate it), the sensor scale against
 // the inverse of the generator's gain, with their intervals' coverage.
 // The residual's line in the summary: on how many sets (and nulls) the diagnosis reported what
-// no model on its list explains, and the final error over each set's floor (median, range).
+// no model on its list explains, the final error over each set's floor (median, range), and how
+// many passed the usual residual and 1.3 times it (where the report makes its claim), nulls apart.
 TEST(Study, CountsTheUnexplainedResidualsAndHowFarAboveTheirFloorsTheSetsAre)
 {
     const fs::path dir = freshDir("residual");
@@ -621,17 +622,23 @@ TEST(Study, CountsTheUnexplainedResidualsAndHowFarAboveTheirFloorsTheSetsAre)
     json older = withFloor(thermalDiagnosis(1.18, 1.1, 1.3, json::object()), 20.0, true);
     older["unexplained_residual"].erase("beyond_usual");
     writeSet(dir, 3, {{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.2}}}}, older);
+    writeSet(dir, 4, {{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.2}}}},
+             withFloor(thermalDiagnosis(1.18, 1.1, 1.3, json::object()), 12.0, true));
     std::ofstream(dir / "plan.json") << json{{"rig", {{"inharmonicity", 1e-3}}}}.dump();
     const std::string md = scoreStudy(dir);
     json study;
     std::ifstream(dir / "study.json") >> study;
     const json& r = study["summary"]["unexplained_residual"];
-    EXPECT_EQ(r["sets"], 3);
+    EXPECT_EQ(r["sets"], 4);
     EXPECT_EQ(r["null_sets"], 1);
-    EXPECT_EQ(r["beyond_usual"], 1); // set 1: 9 over a usual 8
+    EXPECT_EQ(r["beyond_usual"], 2); // set 1: 9 over a usual 8; set 4: 12
+    EXPECT_EQ(r["null_beyond_usual"], 1);
+    EXPECT_EQ(r["firmly_beyond_usual"], 1); // set 4 only: 12 > 1.3 x 8, 9 is not
+    EXPECT_EQ(r["null_firmly_beyond_usual"], 0);
     EXPECT_DOUBLE_EQ(r["median_over_floor"].get<double>(), 9.0);
-    EXPECT_NE(md.find("Unexplained residual reported on 3 of 4 sets (1 of the 2 null sets); final error over the set's floor: median 9.00, "
-                      "from 1.50 to 20.00; more than the usual residual on 1 of 4."),
+    EXPECT_NE(md.find("Unexplained residual reported on 4 of 5 sets (1 of the 2 null sets); final error over the set's floor: median 9.00, "
+                      "from 1.50 to 20.00; more than the usual residual on 2 of 5 (1 null), and more than 1.3 times it, where the "
+                      "report says the rig has something the model lacks, on 1 (0 null)."),
               std::string::npos)
         << md;
     // The usual residual this study measures: the largest ratio where nothing was hidden.

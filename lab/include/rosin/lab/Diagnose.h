@@ -190,6 +190,12 @@ struct Trial {
     bool kept = false;
 };
 
+/// How far past the usual residual a set's must be before the report says the rig has something
+/// the model lacks. The usual residual is the largest of a study's nulls, which fresh nulls pass
+/// now and then (over the ~110 of the fresh verdicts by up to 20 %, none by 30 %); up to this
+/// margin the report calls it a hint. Studies count both, so the margin stays measured.
+inline constexpr double kFirmlyBeyondUsual = 1.3;
+
 /// What the models on the list cannot explain: the final error against the set's own floor.
 struct Residual {
     bool present = false;
