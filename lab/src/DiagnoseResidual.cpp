@@ -14,9 +14,10 @@ namespace rosin::lab::diag {
 
 std::string usualResidualText(const Residual& r)
 {
+    if (r.usual <= 0.0) return "no usual residual was given to compare it with";
     // Only past kFirmlyBeyondUsual (Diagnose.h says why) does the wording claim the rig has
     // something the model lacks.
-    const char* verdict = r.ratio > kFirmlyBeyondUsual * r.usual
+    const char* verdict = isFirmlyBeyondUsual(r.ratio, r.usual)
                               ? "more than the model's usual difference from a real string, by more than any rig with nothing hidden "
                                 "has shown: something on this rig the model lacks"
                           : r.ratio > r.usual
@@ -25,7 +26,6 @@ std::string usualResidualText(const Residual& r)
                                 "the model lacks, not a finding"
                               : "within the model's usual difference from a real string, and says no more than that";
     char buf[700];
-    if (r.usual <= 0.0) return "no usual residual was given to compare it with";
     std::snprintf(buf, sizeof buf,
                   "on the study's reference rigs with nothing hidden (strings, bridges and sensors that differ from the model's as a "
                   "lab's usually do) the final error stayed within %.1f times the floor, so %.1f times is %s",

@@ -102,7 +102,7 @@ Scored readScored(const fs::path& f)
     s.unexplained = d.contains("unexplained_residual") && !d["unexplained_residual"].is_null();
     if (d.contains("floor") && d["floor"].contains("final_over_floor")) s.overFloor = d["floor"]["final_over_floor"].get<double>();
     s.beyondUsual = s.unexplained && d["unexplained_residual"].value("beyond_usual", false);
-    s.firmlyBeyondUsual = s.beyondUsual && s.overFloor > kFirmlyBeyondUsual * d["unexplained_residual"].value("usual_ratio", 0.0);
+    s.firmlyBeyondUsual = s.beyondUsual && isFirmlyBeyondUsual(s.overFloor, d["unexplained_residual"].value("usual_ratio", 0.0));
     if (s.unexplained && d["unexplained_residual"].contains("stand_ins"))
         for (const auto& standIn : d["unexplained_residual"]["stand_ins"]) s.standIns.push_back(standIn["effect"].get<std::string>());
     // The set's units as its diagnosis read them (older plan.json files of newton studies do not

@@ -195,6 +195,8 @@ struct Trial {
 /// now and then (over the ~110 of the fresh verdicts by up to 20 %, none by 30 %); up to this
 /// margin the report calls it a hint. Studies count both, so the margin stays measured.
 inline constexpr double kFirmlyBeyondUsual = 1.3;
+/// Whether a residual of `ratio` floors is past that margin over a usual residual (none when 0).
+inline bool isFirmlyBeyondUsual(double ratio, double usual) { return usual > 0.0 && ratio > kFirmlyBeyondUsual * usual; }
 
 /// What the models on the list cannot explain: the final error against the set's own floor.
 struct Residual {
