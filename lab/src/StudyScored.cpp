@@ -41,6 +41,13 @@ const std::map<std::string, Tolerance>& tolerances()
     return t;
 }
 
+double usualResidualOf(const std::vector<double>& sortedNullOverFloor)
+{
+    const std::size_t n = sortedNullOverFloor.size();
+    const std::size_t rank = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n) - 1e-9));
+    return sortedNullOverFloor[std::clamp<std::size_t>(rank, 1, n) - 1];
+}
+
 Scored readScored(const fs::path& f)
 {
     json t, d;

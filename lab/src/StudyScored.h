@@ -29,6 +29,13 @@ struct Tolerance {
 };
 const std::map<std::string, Tolerance>& tolerances();
 
+/// Nulls from which the usual residual is their 95th percentile rather than their largest.
+inline constexpr std::size_t kNullsForPercentile = 20;
+/// The usual residual that null sets' final errors over floor (sorted, not empty) measure: their
+/// 95th percentile by nearest rank, the ceil(0.95 n)-th smallest, which is the largest for
+/// fewer than twenty.
+double usualResidualOf(const std::vector<double>& sortedNullOverFloor);
+
 struct Scored {
     int index = 0;
     std::string study; ///< the study folder's name, when several studies are scored together

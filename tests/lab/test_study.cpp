@@ -651,6 +651,39 @@ TEST(Study, CountsTheUnexplainedResidualsAndHowFarAboveTheirFloorsTheSetsAre)
     fs::remove_all(dir);
 }
 
+// With twenty nulls or more the usual residual a study measures is their 95th percentile by
+// nearest rank, not their largest: the largest of many nulls grows with their number, and a
+// fresh null should pass the usual residual about one time in twenty whatever the study's size.
+TEST(Study, TheUsualResidualOfTwentyNullsOrMoreIsTheir95thPercentile)
+{
+    const fs::path dir = freshDir("usual95");
+    const json none = diagnosis(json::array({{{"effect", "none"}}}));
+    const json nothing{{"effects", json::array()}, {"params", json::object()}};
+    // Nulls at 1, 2, ..., 20 floors, written out of order: the 19th smallest is 19.
+    for (int k = 0; k < 20; ++k) {
+        json d = none;
+        d["floor"] = {{"final_over_floor", double((k * 7) % 20 + 1)}};
+        writeSet(dir, k, nothing, d);
+    }
+    // A set that hides an effect does not count, however large its residual.
+    json hid = thermalDiagnosis(1.18, 1.1, 1.3, json::object());
+    hid["floor"] = {{"final_over_floor", 50.0}};
+    writeSet(dir, 20, {{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.2}}}}, hid);
+    std::ofstream(dir / "plan.json") << json{{"grid", 12}}.dump();
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    EXPECT_DOUBLE_EQ(study["summary"]["usual_residual_measured"].get<double>(), 19.0);
+    EXPECT_EQ(study["summary"]["null_over_floor"]["nulls"], 20);
+    EXPECT_DOUBLE_EQ(study["summary"]["null_over_floor"]["largest"].get<double>(), 20.0);
+    EXPECT_DOUBLE_EQ(study["summary"]["null_over_floor"]["median"].get<double>(), 11.0);
+    EXPECT_NE(md.find("The null sets' final error over floor: median 11.0, 95th percentile 19.0, largest 20.0 (1 of 20 nulls above the 95th "
+                      "percentile); the 95th percentile is this rig population's usual residual (`rosin diagnose --usual-residual 19.0` takes it)."),
+              std::string::npos)
+        << md;
+    fs::remove_all(dir);
+}
+
 // Rule 6's stand-ins are not named: they count neither as detections nor as false positives, and
 // the summary says on how many sets they were set aside and whether each was hidden there (a miss)
 // or not (a wrong label kept out).
