@@ -18,17 +18,17 @@ std::string usualResidualText(const Residual& r)
     // Only past kFirmlyBeyondUsual (Diagnose.h says why) does the wording claim the rig has
     // something the model lacks.
     const char* verdict = isFirmlyBeyondUsual(r.ratio, r.usual)
-                              ? "more than the model's usual difference from a real string, by more than any rig with nothing hidden "
-                                "has shown: something on this rig the model lacks"
+                              ? "more than the model's usual difference from a real string, by a margin that about one rig in a hundred with "
+                                "nothing hidden reaches: something on this rig the model lacks"
                           : r.ratio > r.usual
-                              ? "a little more than the model's usual difference from a real string (ordinary rigs with nothing hidden "
-                                "pass that bound now and then, by up to 20 % on the studies' fresh null sets): a hint that this rig has something "
-                                "the model lacks, not a finding"
+                              ? "a little more than the model's usual difference from a real string (about one rig in twenty with nothing "
+                                "hidden passes that bound, and those that do by up to 40 %): a hint that this rig has something the model "
+                                "lacks, not a finding"
                               : "within the model's usual difference from a real string, and says no more than that";
     char buf[700];
     std::snprintf(buf, sizeof buf,
-                  "on the study's reference rigs with nothing hidden (strings, bridges and sensors that differ from the model's as a "
-                  "lab's usually do) the final error stayed within %.1f times the floor, so %.1f times is %s",
+                  "on the studies' reference rigs with nothing hidden (strings, bridges and sensors that differ from the model's as a "
+                  "lab's usually do) the final error stays within %.1f times the floor on about nineteen in twenty; %.1f times is %s",
                   r.usual, r.ratio, verdict);
     return buf;
 }
