@@ -339,7 +339,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     md << "Null sets naming any effect: " << nullFp << " of " << nNull << fmt(" (%.0f %%).\n", nNull ? 100.0 * nullFp / nNull : 0.0);
     // What the models on the list could not explain, and how far above the sets' own floors.
     int residuals = 0, nullResiduals = 0, beyondUsual = 0, nullBeyondUsual = 0, firmlyBeyond = 0, nullFirmlyBeyond = 0;
-    std::vector<double> overFloor;
+    std::vector<double> overFloor, nullOverFloor;
     for (const auto& s : sets) {
         residuals += s.unexplained;
         beyondUsual += s.beyondUsual;
@@ -348,6 +348,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         nullFirmlyBeyond += s.firmlyBeyondUsual && s.hidden.empty();
         nullResiduals += s.unexplained && s.hidden.empty();
         overFloor.push_back(s.overFloor);
+        if (s.hidden.empty() && s.overFloor > 0) nullOverFloor.push_back(s.overFloor);
     }
     std::sort(overFloor.begin(), overFloor.end());
     md << "Unexplained residual reported on " << residuals << " of " << sets.size() << " sets (" << nullResiduals << " of the " << nNull
@@ -359,9 +360,6 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     // The usual residual: what the model leaves where nothing is hidden, on this rig population.
     // The nulls' 95th percentile by nearest rank: a fresh null passes it about one time in
     // twenty. Under twenty nulls that rank is the largest, the value studies took before.
-    std::vector<double> nullOverFloor;
-    for (const auto& s : sets)
-        if (s.hidden.empty() && s.overFloor > 0) nullOverFloor.push_back(s.overFloor);
     if (!nullOverFloor.empty()) {
         std::sort(nullOverFloor.begin(), nullOverFloor.end());
         const std::size_t n = nullOverFloor.size();
