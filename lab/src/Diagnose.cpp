@@ -169,7 +169,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                    "must not have the other sign than round 1's shift candidate when that one was 10 K or more (else it stands in for the rate law's form), (3) it also lowers the error of the test strokes, "
                    "(4) the 95 % interval of its parameter excludes the no-effect value (exponent 1, shift 0 K, "
                    "Z_t/Z_0 >= 7.5, speed exponent <= 0.03), both the bootstrap refits' interval and that interval widened in quadrature "
-                   "by the model discrepancy the studies measured (the one the report prints" + nameableEdgesText(o) + "), and (5) refitted on the low- and on the high-drive half of the fit strokes "
+                   "by the model discrepancy the studies measured (the one the report prints" + nameableEdgesText(o) + "), and (5) searched afresh on the low- and on the high-drive half of the fit strokes "
                    "(bow acceleration; v0/tv for exp_speed and bow speed for exp_force strokes, each gesture split at its own median) it keeps away from the no-effect value with consistent values. Every candidate is fitted with the nuisances and the "
                    "parameters of effects already named free beside its own. A parameter fitted within 1 % of either end of its search range "
                    "(r_A 0.5-2, p 0.1-0.8, load exponent 0.4-1.1, shift -30 to +30 K, Z_t/Z_0 0.7-8) is a stand-in and is not named; "
@@ -324,10 +324,8 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             }
             if (atNullInterval) { trial.verdict = "interval reaches the no-effect value"; return false; }
             if (atNullWithDiscrepancy) { trial.verdict = "interval reaches the no-effect value once the model discrepancy is counted"; return false; }
-            // (5) the two force halves of the fit strokes
-            std::vector<std::vector<double>> halves;
-            for (bool high : {false, true})
-                halves.push_back(diag::fit(engine, current, t.c, subset(fitSet, strokes, high), t.x, std::max(8, o.maxEvaluations / 2), 0.1, nullptr, false));
+            // (5) the two drive halves of the fit strokes
+            const std::vector<std::vector<double>> halves = driveHalves(engine, current, t.c, fitSet, strokes, t.x, o.maxEvaluations);
             if (!halvesConsistent(t.c, halves[0], halves[1], halfWidth)) {
                 trial.verdict = "not consistent on the two drive halves (bow acceleration, or the gesture's own drive)";
                 return false;

@@ -238,6 +238,11 @@ std::vector<double> secondGridStart(const std::vector<std::pair<double, std::vec
 /// Tension and bow position are searched within boundsOf() the engine's set, whatever the candidate says.
 std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<std::size_t>& on,
                         std::vector<double> start, int maxEval, double step, double* best = nullptr, bool scan = true, bool secondStart = false);
+/// Rule 5's refits on the low- and high-drive halves of the fit strokes (subset()): each a whole
+/// search of the candidate's own parameters (grid and COBYLA), the nuisances starting at the
+/// estimate, so the halves' values do not depend on where the estimate stood.
+std::vector<std::vector<double>> driveHalves(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<std::size_t>& fitSet,
+                                             const std::vector<Prepared>& strokes, const std::vector<double>& estimate, int maxEval);
 /// Paired bootstrap of the mean of before - after: {mean, low, high} (95 %).
 std::array<double, 3> pairedGain(const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after, int B, std::uint64_t seed);
 /// True when [lo, hi] reaches the parameter's no-effect value.
