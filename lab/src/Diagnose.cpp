@@ -325,7 +325,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             if (atNullInterval) { trial.verdict = "interval reaches the no-effect value"; return false; }
             if (atNullWithDiscrepancy) { trial.verdict = "interval reaches the no-effect value once the model discrepancy is counted"; return false; }
             // (5) the two drive halves of the fit strokes
-            const std::vector<std::vector<double>> halves = driveHalves(engine, current, t.c, fitSet, strokes, t.x, o.maxEvaluations);
+            const std::vector<std::vector<double>> halves = diag::driveHalves(engine, current, t.c, fitSet, strokes, t.x, o.maxEvaluations);
             if (!halvesConsistent(t.c, halves[0], halves[1], halfWidth)) {
                 trial.verdict = "not consistent on the two drive halves (bow acceleration, or the gesture's own drive)";
                 return false;

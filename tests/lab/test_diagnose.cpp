@@ -60,8 +60,10 @@ MeasurementSet modelSetFromDisk(const SynthSpec& spec, SynthTruth& truth)
     return set;
 }
 
-/// A model-made 4x4 set's strokes, prepared as a diagnosis prepares them.
-std::vector<diag::Prepared> preparedModelSet(std::vector<std::string> effects, std::uint64_t seed, diag::StringInfo& info, Diagnosis& d)
+/// A model-made 4x4 set's strokes, prepared as a diagnosis prepares them (its truth in `truthOut`
+/// when given).
+std::vector<diag::Prepared> preparedModelSet(std::vector<std::string> effects, std::uint64_t seed, diag::StringInfo& info, Diagnosis& d,
+                                             SynthTruth* truthOut = nullptr)
 {
     SynthSpec spec;
     spec.effects = std::move(effects);
@@ -69,6 +71,7 @@ std::vector<diag::Prepared> preparedModelSet(std::vector<std::string> effects, s
     spec.grid = 4;
     SynthTruth truth;
     const MeasurementSet set = modelSetFromDisk(spec, truth);
+    if (truthOut) *truthOut = truth;
     info = diag::stringInfoOf(set);
     return diag::prepareStrokes(set, info, DiagnoseOptions{}, d);
 }
@@ -546,15 +549,10 @@ TEST(DiagnoseParameters, TheGridSpansOnlyParametersTheDataFix)
 // Each half is now a whole search, so where the estimate stood does not matter.
 TEST(DiagnoseParameters, RuleFiveSearchesEachDriveHalfAfreshWhereverTheEstimateStood)
 {
-    SynthSpec spec;
-    spec.effects = {"hertzian_contact"};
-    spec.seed = 27;
-    spec.grid = 4;
-    SynthTruth truth;
-    const MeasurementSet set = modelSetFromDisk(spec, truth);
-    diag::StringInfo info = diag::stringInfoOf(set);
+    diag::StringInfo info;
     Diagnosis d;
-    std::vector<diag::Prepared> strokes = diag::prepareStrokes(set, info, DiagnoseOptions{}, d);
+    SynthTruth truth;
+    std::vector<diag::Prepared> strokes = preparedModelSet({"hertzian_contact"}, 27, info, d, &truth);
     const DiagnoseOptions o;
     const diag::Engine engine(strokes, info, o.simRate, std::nullopt, false);
     const auto contact = offered(diag::candidates(EffectModel{}), "hertzian_contact");
