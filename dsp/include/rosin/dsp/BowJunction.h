@@ -85,7 +85,7 @@ public:
         applyShiftAndScale();
     }
 
-    /// [audio thread] Footprint ratio r_A (bow / steady test): scales the temperature law.
+    /// [audio thread] Footprint ratio r_A (bow / steady test): scales the temperature law and the heated area.
     void setFootprintRatio(double ratio) noexcept
     {
         if (!(ratio > 0.0) || !std::isfinite(ratio) || ratio == params_.thermal.footprintRatio) return;
@@ -339,11 +339,14 @@ private:
     }
 
     /// Friction and heat carry per unit load, so a sudden drop in force does not pour the last
-    /// sample's heat into a tiny footprint.
+    /// sample's heat into a tiny footprint. The heat spreads over the bow's own footprint,
+    /// r_A K_A times the load: r_A is the bow's area over the steady test's, so it scales the
+    /// area that takes the heat as well as the friction (the law's scale does that).
     double stepTemperature() noexcept
     {
         const double load = loadCached_;
-        return thermal_.step(heatPerLoadPrev_ * load, slidePrev_, area_.areaPerNewton * load, heatSlopePerLoadPrev_ * load);
+        return thermal_.step(heatPerLoadPrev_ * load, slidePrev_, params_.thermal.footprintRatio * area_.areaPerNewton * load,
+                             heatSlopePerLoadPrev_ * load);
     }
 
     /// What this sample leaves for the next temperature step: heat |f dv| and sliding speed, and

@@ -366,6 +366,8 @@ public:
     }
 
     double temperature() const noexcept { return theta_; }
+    /// The footprint the last step's heat spread over (m^2).
+    double footprintArea() const noexcept { return areaCached_; }
     const ThermalParams& params() const noexcept { return params_; }
 
 private:
