@@ -200,13 +200,21 @@ TEST(ThermalModel, TheHeatSpreadsOverTheBowsOwnFootprint)
             fp.contactLaw = law;
             fp.contactExponent = 0.7;
             fp.thermal.footprintRatio = ratio;
-            BowJunction<double> j;
+            BowJunction<double> j, turned; // r_A set at prepare, or turned to it while playing
             j.prepare(48000.0, fp);
+            fp.thermal.footprintRatio = 1.0;
+            turned.prepare(48000.0, fp);
+            turned.setFootprintRatio(ratio);
             const double v = 0.2, force = 1.3;
-            for (int n = 0; n < 480; ++n) j.solve(0.0, v, force, 1e9); // clamped string: slips at v
+            for (int n = 0; n < 480; ++n) { // clamped string: slips at v
+                j.solve(0.0, v, force, 1e9);
+                turned.solve(0.0, v, force, 1e9);
+            }
             const double load = law == ContactLaw::Amontons ? force : std::pow(force, 0.7);
-            EXPECT_NEAR(j.thermal().footprintArea() / (ratio * std::numbers::pi * 250e-6 * 250e-6 * load), 1.0, 1e-12)
-                << "r_A " << ratio;
+            const double expected = ratio * std::numbers::pi * 250e-6 * 250e-6 * load;
+            EXPECT_NEAR(j.thermal().footprintArea() / expected, 1.0, 1e-12) << "r_A " << ratio;
+            EXPECT_NEAR(turned.thermal().footprintArea() / expected, 1.0, 1e-12) << "turned to r_A " << ratio;
+            EXPECT_NEAR(j.contactArea().area(force) / expected, 1.0, 1e-12) << "one footprint, r_A " << ratio;
         }
     }
 }

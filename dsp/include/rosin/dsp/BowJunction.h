@@ -90,6 +90,7 @@ public:
     {
         if (!(ratio > 0.0) || !std::isfinite(ratio) || ratio == params_.thermal.footprintRatio) return;
         params_.thermal.footprintRatio = ratio;
+        area_.configure(params_.contactLaw, params_.contactExponent, params_.thermal);
         applyShiftAndScale();
     }
 
@@ -339,13 +340,13 @@ private:
     }
 
     /// Friction and heat carry per unit load, so a sudden drop in force does not pour the last
-    /// sample's heat into a tiny footprint. The heat spreads over the bow's own footprint,
-    /// r_A K_A times the load: r_A is the bow's area over the steady test's, so it scales the
-    /// area that takes the heat as well as the friction (the law's scale does that).
+    /// sample's heat into a tiny footprint. The heat spreads over the bow's own footprint
+    /// (ContactArea carries r_A K_A): r_A is the bow's area over the steady test's, so it
+    /// scales the area that takes the heat as well as the friction (the law's scale does that).
     double stepTemperature() noexcept
     {
         const double load = loadCached_;
-        return thermal_.step(heatPerLoadPrev_ * load, slidePrev_, params_.thermal.footprintRatio * area_.areaPerNewton * load,
+        return thermal_.step(heatPerLoadPrev_ * load, slidePrev_, area_.areaPerNewton * load,
                              heatSlopePerLoadPrev_ * load);
     }
 

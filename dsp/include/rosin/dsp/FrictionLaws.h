@@ -114,18 +114,20 @@ struct ThermalParams {
 
 /// Contact area as a function of bow force, shared by friction and heat balance so both see
 /// the same footprint. Friction = A * tau_y(theta), written as effectiveLoad * mu(theta).
+/// The area is the bow's own, r_A K_A per unit load: the steady test's footprint times the
+/// footprint ratio, so the heat spreads where the bow touches.
 struct ContactArea {
     ContactLaw law = ContactLaw::Amontons;
     double exponent = 2.0 / 3.0;
     double referenceLoad = 1.0;
-    double areaPerNewton = std::numbers::pi * 250e-6 * 250e-6; ///< K_A = A_ref / F_ref
+    double areaPerNewton = std::numbers::pi * 250e-6 * 250e-6; ///< r_A K_A, K_A = A_ref / F_ref
 
     void configure(ContactLaw l, double n, const ThermalParams& tp) noexcept
     {
         law = l;
         exponent = n;
         referenceLoad = tp.referenceLoad;
-        areaPerNewton = std::numbers::pi * tp.contactRadiusAtRef * tp.contactRadiusAtRef / tp.referenceLoad;
+        areaPerNewton = tp.footprintRatio * std::numbers::pi * tp.contactRadiusAtRef * tp.contactRadiusAtRef / tp.referenceLoad;
     }
 
     /// The load that multiplies mu: F itself (Amontons) or F_ref (F/F_ref)^n, equal at F_ref.
