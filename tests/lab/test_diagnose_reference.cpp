@@ -21,6 +21,7 @@
 #include "rosin/lab/Error.h"
 #include "rosin/lab/Measurement.h"
 #include "rosin/lab/ReferenceData.h"
+#include "rosin/lab/Study.h"
 
 using namespace rosin::lab;
 namespace fs = std::filesystem;
@@ -548,6 +549,31 @@ TEST(DiagnoseReferenceLong, AnEarlierFindingIsTestedAgainstAModelSearchedAsHard)
     EXPECT_NEAR(keptShare(3, "rate_dependence"), 0.506, 0.02);
     EXPECT_NEAR(keptShare(3, "hertzian_contact"), 0.410, 0.02);
     EXPECT_NEAR(keptShare(2, "rate_dependence"), 0.359, 0.02);
+}
+
+// Rule 4 asked of a round's own finding where the joint refit left it: seed 2079's set 6 (a 9.1 K
+// shift) under its own split, as `rosin study --seed 2079 --split-per-set --diagnose-seed 2`
+// diagnoses it. Round 1's shift passes rules 1-5 at 17.4 K; the joint refit moves it to 15.5 K,
+// under the 15.7 K that rule 4 can name, so it is not named and not tried again. Before the
+// rule, it was named there with a printed interval holding 0 K.
+TEST(DiagnoseReferenceLong, ARoundsOwnFindingTheJointRefitMovesUnderRuleFourIsNotNamed)
+{
+    SynthTruth truth;
+    const MeasurementSet set = studySet({"rosin_temperature_shift"}, 2079007, truth);
+    ASSERT_NEAR(truth.params.at("shift_k"), 9.14, 0.01);
+    DiagnoseOptions o;
+    o.seed = perSetDiagnoseSeed(2, 2079007);
+    const Diagnosis d = diagnose(set, o);
+    EXPECT_NE(findingOf(d, "thermal_memory"), nullptr);
+    EXPECT_EQ(findingOf(d, "rosin_temperature_shift"), nullptr);
+    const auto unnamed = std::find_if(d.trials.begin(), d.trials.end(), [](const Trial& t) {
+        return t.effect == "rosin_temperature_shift" && t.verdict.find("then the joint refit moved") != std::string::npos;
+    });
+    ASSERT_NE(unnamed, d.trials.end());
+    EXPECT_EQ(unnamed->round, 1);
+    EXPECT_FALSE(unnamed->kept);
+    EXPECT_NEAR(unnamed->parameters.at("shift_k"), 17.4, 0.5);
+    for (const Trial& t : d.trials) EXPECT_FALSE(t.round > 1 && t.effect == "rosin_temperature_shift") << "tried again in round " << t.round;
 }
 
 TEST(DiagnoseReferenceLong, FindsARosinShift) { expectDiagnosis(run({"rosin_temperature_shift"}, {{"r_A", 1.2}, {"shift_k", -14.0}}, 45)); }
