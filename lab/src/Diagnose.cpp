@@ -176,7 +176,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
                    "h0, which no data fix, is asked neither this nor (5).",
                "After each new finding all parameters are refitted together, and every finding, the new one included, must still hold rule 4's "
                "interval clear of its no-effect value where the refit left it; every earlier one must also still earn its place: the model is refitted without it, and an effect whose "
-               "absence raises the validation error by less than the naming threshold is dropped. A dropped effect is not tried again.",
+               "absence raises the validation error by less than the naming threshold is dropped. A dropped effect is not tried again. A new "
+               "finding that fails rule 4 there, or once refitted without an earlier finding it displaced, is not named: the round is undone, "
+               "the earlier findings stand as they were, and the new effect is not tried again.",
                "The reported gain compares the calibrated baseline and the final model on the test strokes only."};
     if (o.tryPairs)
         d.rules.push_back("When a round names nothing, a Hertzian contact and a rolling string still open are tried together as one candidate "
@@ -422,12 +424,14 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         // earlier ones below: a refit that moves it to where its interval reaches no effect says the
         // data do not prove it (seed 2079, set 6: a shift judged at 17.4 K, refitted to 15.5 K, under
         // the 15.7 K that rule 4 can name). The round names nothing, and the effect is not tried again.
-        if (const auto found = newFindings(current);
-            std::any_of(found.begin(), found.end(), [&](const Finding& f) { return movedToNull(f, current.params, o); })) {
-            Trial& trial = d.trials[best->trial];
-            trial.kept = false;
-            trial.verdict = "passed rules 1-5, then the joint refit moved its parameter to where its interval reaches the no-effect value";
-            for (const auto& effect : membersOf(best->c.effect)) dropped.insert(effect);
+        const diag::RoundStart roundStart = diag::roundStart(d, dropped);
+        auto ownFindingAtNull = [&] {
+            const auto found = newFindings(current);
+            return std::any_of(found.begin(), found.end(), [&](const Finding& f) { return movedToNull(f, current.params, o); });
+        };
+        if (ownFindingAtNull()) {
+            diag::undoRound(d, dropped, roundStart, best->trial, membersOf(best->c.effect),
+                            "passed rules 1-5, then the joint refit moved its parameter to where its interval reaches the no-effect value");
             current = from;
             currentVal = stepBefore;
             continue;
@@ -497,6 +501,16 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
             earlier = removed(earlier, weakest->effect);
             current = weakest->model;
             currentVal = weakest->val;
+        }
+        // Refitted without an earlier finding it displaced, this round's own finding is asked rule 4
+        // again: if it now reaches no effect, neither change is proved and the round is undone.
+        if (d.findings.size() < roundStart.findings.size() && ownFindingAtNull()) {
+            diag::undoRound(d, dropped, roundStart, best->trial, membersOf(best->c.effect),
+                            "passed rules 1-5, then refitted without the earlier finding it displaced its parameter moved to where its "
+                            "interval reaches the no-effect value");
+            current = from;
+            currentVal = stepBefore;
+            continue;
         }
         // Earlier findings report where their parameters are now (they moved with this round's fit).
         for (auto& f : d.findings)

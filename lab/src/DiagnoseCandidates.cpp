@@ -2,6 +2,8 @@
 // its result must pass before it is named (how it is fitted: DiagnoseSearch.cpp).
 #include <algorithm>
 #include <map>
+#include <set>
+#include <string>
 #include <cmath>
 #include <cstdio>
 
@@ -376,6 +378,31 @@ bool movedToNull(const Finding& f, const std::map<std::string, double>& now, con
         if (intervalAtNull(name, at->second - half, at->second + half)) return true;
     }
     return false;
+}
+
+RoundStart roundStart(const Diagnosis& d, const std::set<std::string>& dropped)
+{
+    return {d.findings, dropped, d.trials.size()};
+}
+
+std::vector<std::string> undoRound(Diagnosis& d, std::set<std::string>& dropped, const RoundStart& start, std::size_t winnerTrial,
+                                   const std::vector<std::string>& winnerEffects, const std::string& verdict)
+{
+    std::vector<std::string> back;
+    for (const Finding& f : start.findings)
+        if (std::none_of(d.findings.begin(), d.findings.end(), [&](const Finding& now) { return now.effect == f.effect; })) back.push_back(f.effect);
+    d.findings = start.findings;
+    dropped = start.dropped;
+    if (d.trials.size() > start.trials) d.trials.resize(start.trials);
+    if (winnerTrial < d.trials.size()) {
+        std::string said = verdict;
+        for (std::size_t k = 0; k < back.size(); ++k) said += (k == 0 ? "; the round is undone and " : " and ") + back[k];
+        if (!back.empty()) said += back.size() == 1 ? ", which it had displaced, stands again" : ", which it had displaced, stand again";
+        d.trials[winnerTrial].kept = false;
+        d.trials[winnerTrial].verdict = said;
+    }
+    dropped.insert(winnerEffects.begin(), winnerEffects.end());
+    return back;
 }
 
 std::optional<std::vector<double>> roundOneStart(const std::vector<Trial>& trials, const Candidate& c)

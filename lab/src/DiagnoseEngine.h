@@ -14,6 +14,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -268,6 +269,21 @@ std::string shiftMarginText(const DiagnoseOptions& o);
 /// `now`: does the interval it was named with (the same bootstrap half-width around the new
 /// value, widened by the model discrepancy as rule 4 widens it) reach the no-effect value?
 bool movedToNull(const Finding& f, const std::map<std::string, double>& now, const DiagnoseOptions& o);
+/// What the report held when a round's winner was kept, before the earlier findings were asked
+/// again beside it: enough to undo the round whole if the winner fails rule 4 after all.
+struct RoundStart {
+    std::vector<Finding> findings;
+    std::set<std::string> dropped;
+    std::size_t trials = 0;
+};
+RoundStart roundStart(const Diagnosis& d, const std::set<std::string>& dropped);
+/// Undo a round whose winner the data no longer prove: the earlier findings it displaced come back
+/// with the values they had, the trial rows written since `start` go, and the winner's trial
+/// (`winnerTrial`) is marked not kept with `verdict`, which then names any displaced finding that
+/// stands again; its effects (`winnerEffects`) are not tried again. Returns the effects that had
+/// been displaced and are back.
+std::vector<std::string> undoRound(Diagnosis& d, std::set<std::string>& dropped, const RoundStart& start, std::size_t winnerTrial,
+                                   const std::vector<std::string>& winnerEffects, const std::string& verdict);
 /// How far `after` lies below `before`, as a share of `before` (0 when there is nothing to fall from).
 double relativeFall(double before, double after);
 /// Rule 2's comparisons of candidate `c` (fitted as `trial`) with the round's other candidates,

@@ -295,6 +295,67 @@ TEST(DiagnoseParameters, AnEarlierFindingMovedTowardNoEffectIsJudgedByTheInterva
 
 // Round 1's shift candidate (before any rate law) against the shift fitted beside a named one:
 // only a sign flip after a round-1 shift of 10 K or more counts.
+// A round undone after its winner failed rule 4 (at the joint refit, or refitted without an earlier
+// finding it displaced): the displaced finding comes back with the values it had, the rows the
+// round wrote while asking earlier findings again go, the winner's row says why it is not kept and
+// what stands again, and the winner's effect is not tried again. Nothing else in the report moves.
+TEST(DiagnoseParameters, AnUndoneRoundRestoresTheFindingsItDisplacedAndNamesNothing)
+{
+    Diagnosis d;
+    Finding thermal, shift;
+    thermal.effect = "thermal_memory";
+    thermal.parameters["r_A"] = {1.02, 0.97, 1.07};
+    shift.effect = "rosin_temperature_shift";
+    shift.parameters["shift_k"] = {18.0, 14.0, 22.0};
+    d.findings = {thermal, shift};
+    for (int k = 0; k < 3; ++k) {
+        Trial t;
+        t.round = 3;
+        t.effect = k == 1 ? "hertzian_contact" : "torsional_compliance";
+        t.verdict = k == 1 ? "named" : "validation fall not significant";
+        d.trials.push_back(t);
+    }
+    d.trials[1].kept = true;
+    std::set<std::string> dropped = {"rate_dependence"};
+    const diag::RoundStart start = diag::roundStart(d, dropped);
+    EXPECT_EQ(start.trials, 3u);
+
+    // the round drops the shift beside the contact and records it, and the contact moves on
+    d.findings.pop_back();
+    d.findings.front().parameters["r_A"] = {0.91, 0.86, 0.96};
+    Trial row;
+    row.round = 3;
+    row.effect = "rosin_temperature_shift";
+    row.verdict = "dropped: beside hertzian_contact it no longer lowers the validation error by the threshold";
+    d.trials.push_back(row);
+    dropped.insert("rosin_temperature_shift");
+
+    const auto back = diag::undoRound(d, dropped, start, 1, {"hertzian_contact"}, "passed rules 1-5, then it failed rule 4");
+    ASSERT_EQ(back, std::vector<std::string>{"rosin_temperature_shift"});
+    ASSERT_EQ(d.findings.size(), 2u);
+    EXPECT_EQ(d.findings[1].effect, "rosin_temperature_shift");
+    EXPECT_DOUBLE_EQ(d.findings[1].parameters.at("shift_k")[0], 18.0);
+    EXPECT_DOUBLE_EQ(d.findings[0].parameters.at("r_A")[0], 1.02);
+    ASSERT_EQ(d.trials.size(), 3u);
+    EXPECT_FALSE(d.trials[1].kept);
+    EXPECT_EQ(d.trials[1].verdict, "passed rules 1-5, then it failed rule 4; the round is undone and rosin_temperature_shift, which it had "
+                                   "displaced, stands again");
+    EXPECT_EQ(d.trials[0].verdict, "validation fall not significant");
+    EXPECT_EQ(dropped, (std::set<std::string>{"rate_dependence", "hertzian_contact"}));
+
+    // undone before anything was displaced: the verdict is the one given, and nothing comes back
+    Diagnosis plain;
+    plain.trials.resize(2);
+    plain.trials[0].kept = true;
+    std::set<std::string> none;
+    const auto nothing = diag::undoRound(plain, none, diag::roundStart(plain, none), 0, {"torsional_compliance", "hertzian_contact"}, "failed rule 4");
+    EXPECT_TRUE(nothing.empty());
+    EXPECT_EQ(plain.trials.size(), 2u);
+    EXPECT_FALSE(plain.trials[0].kept);
+    EXPECT_EQ(plain.trials[0].verdict, "failed rule 4");
+    EXPECT_EQ(none, (std::set<std::string>{"torsional_compliance", "hertzian_contact"}));
+}
+
 TEST(DiagnoseParameters, AShiftThatFlipsSignBesideARateLawIsAStandIn)
 {
     auto trial = [](int round, const std::string& effect, double shift) {
