@@ -506,7 +506,7 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         // again: if it now reaches no effect, neither change is proved and the round is undone.
         if (d.findings.size() < roundStart.findings.size() && ownFindingAtNull()) {
             diag::undoRound(d, dropped, roundStart, best->trial, membersOf(best->c.effect),
-                            "passed rules 1-5, then refitted without the earlier finding it displaced its parameter moved to where its "
+                            "passed rules 1-5, then, refitted without the earlier finding it displaced, its parameter moved to where its "
                             "interval reaches the no-effect value");
             current = from;
             currentVal = stepBefore;
