@@ -424,16 +424,19 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         // earlier ones below: a refit that moves it to where its interval reaches no effect says the
         // data do not prove it (seed 2079, set 6: a shift judged at 17.4 K, refitted to 15.5 K, under
         // the 15.7 K that rule 4 can name). The round names nothing, and the effect is not tried again.
-        const diag::RoundStart roundStart = diag::roundStart(d, dropped);
+        const diag::RoundStart atRoundStart = diag::roundStart(d, dropped);
         auto ownFindingAtNull = [&] {
             const auto found = newFindings(current);
             return std::any_of(found.begin(), found.end(), [&](const Finding& f) { return movedToNull(f, current.params, o); });
         };
-        if (ownFindingAtNull()) {
-            diag::undoRound(d, dropped, roundStart, best->trial, membersOf(best->c.effect),
-                            "passed rules 1-5, then the joint refit moved its parameter to where its interval reaches the no-effect value");
+        // the report and the model go back to where the round began
+        auto undoThisRound = [&](const std::string& verdict) {
+            diag::undoRound(d, dropped, atRoundStart, best->trial, membersOf(best->c.effect), verdict);
             current = from;
             currentVal = stepBefore;
+        };
+        if (ownFindingAtNull()) {
+            undoThisRound("passed rules 1-5, then the joint refit moved its parameter to where its interval reaches the no-effect value");
             continue;
         }
         // An effect named earlier may have stood in for the one named now (a rosin shift for a
@@ -504,12 +507,9 @@ Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const st
         }
         // Refitted without an earlier finding it displaced, this round's own finding is asked rule 4
         // again: if it now reaches no effect, neither change is proved and the round is undone.
-        if (d.findings.size() < roundStart.findings.size() && ownFindingAtNull()) {
-            diag::undoRound(d, dropped, roundStart, best->trial, membersOf(best->c.effect),
-                            "passed rules 1-5, then, refitted without the earlier finding it displaced, its parameter moved to where its "
-                            "interval reaches the no-effect value");
-            current = from;
-            currentVal = stepBefore;
+        if (d.findings.size() < atRoundStart.findings.size() && ownFindingAtNull()) {
+            undoThisRound("passed rules 1-5, then, refitted without the earlier finding it displaced, its parameter moved to where its "
+                          "interval reaches the no-effect value");
             continue;
         }
         // Earlier findings report where their parameters are now (they moved with this round's fit).

@@ -293,8 +293,6 @@ TEST(DiagnoseParameters, AnEarlierFindingMovedTowardNoEffectIsJudgedByTheInterva
     EXPECT_FALSE(diag::movedToNull(thermal, {{"r_A", 0.01}}, shipped));
 }
 
-// Round 1's shift candidate (before any rate law) against the shift fitted beside a named one:
-// only a sign flip after a round-1 shift of 10 K or more counts.
 // A round undone after its winner failed rule 4 (at the joint refit, or refitted without an earlier
 // finding it displaced): the displaced finding comes back with the values it had, the rows the
 // round wrote while asking earlier findings again go, the winner's row says why it is not kept and
@@ -356,6 +354,8 @@ TEST(DiagnoseParameters, AnUndoneRoundRestoresTheFindingsItDisplacedAndNamesNoth
     EXPECT_EQ(none, (std::set<std::string>{"torsional_compliance", "hertzian_contact"}));
 }
 
+// Round 1's shift candidate (before any rate law) against the shift fitted beside a named one:
+// only a sign flip after a round-1 shift of 10 K or more counts.
 TEST(DiagnoseParameters, AShiftThatFlipsSignBesideARateLawIsAStandIn)
 {
     auto trial = [](int round, const std::string& effect, double shift) {
