@@ -11,10 +11,6 @@
 
 namespace rosin::lab::diag {
 
-namespace {
-bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
-} // namespace
-
 /// The candidate with the model's nuisances free beside its own parameters: an effect has to
 /// beat a model whose calibration could move too (a rolling string looks a little like a
 /// softer one, and must not be absorbed by the tension before torsion is tried). The parameters

@@ -55,6 +55,8 @@ constexpr double kCompareCutoff = 5000.0; // both signals see the same low-pass 
 /// Classifier input for a stroke of gesture g on string s: the bow speed follows the gesture, and
 /// a rising-force stroke (which slides from the start) gives the shape of its pre-slip force.
 ClassifierInput strokeInput(std::vector<double> f, double fs, const Gesture& g, const StringInfo& s);
+/// True when the list of effects (or names) v holds x.
+inline bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
 /// x printed with the printf format f, for the report's sentences and tables and the figures' data.
 inline std::string fmt(double x, const char* f = "%.3g")
 {
