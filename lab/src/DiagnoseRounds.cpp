@@ -282,7 +282,7 @@ void NamingRounds::jointRefit()
     }
 }
 
-void NamingRounds::record(const Without& w, const std::string& verdict)
+void NamingRounds::recordWithout(const Without& w, const std::string& verdict)
 {
     Trial t;
     t.round = round_;
@@ -333,10 +333,10 @@ void NamingRounds::askEarlierFindings()
         const auto weakest =
             stale != tested.end() ? stale : std::min_element(tested.begin(), tested.end(), [](const Without& a, const Without& b) { return a.share < b.share; });
         if (weakest == tested.end() || (stale == tested.end() && weakest->share >= o_.namingThreshold)) {
-            for (const Without& w : tested) record(w, "kept beside " + best_->c.effect + ": without it the validation error rises by the share shown");
+            for (const Without& w : tested) recordWithout(w, "kept beside " + best_->c.effect + ": without it the validation error rises by the share shown");
             return;
         }
-        record(*weakest, stale != tested.end() ? "dropped: beside " + best_->c.effect + " its parameter moved to where its interval reaches the no-effect value"
+        recordWithout(*weakest, stale != tested.end() ? "dropped: beside " + best_->c.effect + " its parameter moved to where its interval reaches the no-effect value"
                                                : "dropped: beside " + best_->c.effect + " it no longer lowers the validation error by the threshold");
         d_.findings.erase(std::remove_if(d_.findings.begin(), d_.findings.end(), [&](const Finding& f) { return f.effect == weakest->effect; }),
                           d_.findings.end());
@@ -347,7 +347,7 @@ void NamingRounds::askEarlierFindings()
     }
 }
 
-void NamingRounds::undoRound(const std::string& verdict)
+void NamingRounds::undoThisRound(const std::string& verdict)
 {
     diag::undoRound(d_, dropped_, atRoundStart_, best_->trial, membersOf(best_->c.effect), verdict);
     current_ = from_;
@@ -400,14 +400,14 @@ bool NamingRounds::nextRound()
     // the 15.7 K that rule 4 can name). The round names nothing, and the effect is not tried again.
     atRoundStart_ = roundStart(d_, dropped_);
     if (ownFindingAtNull()) {
-        undoRound("passed rules 1-5, then the joint refit moved its parameter to where its interval reaches the no-effect value");
+        undoThisRound("passed rules 1-5, then the joint refit moved its parameter to where its interval reaches the no-effect value");
         return true;
     }
     askEarlierFindings();
     // Refitted without an earlier finding it displaced, this round's own finding is asked rule 4
     // again: if it now reaches no effect, neither change is proved and the round is undone.
     if (d_.findings.size() < atRoundStart_.findings.size() && ownFindingAtNull()) {
-        undoRound("passed rules 1-5, then, refitted without the earlier finding it displaced, its parameter moved to where its "
+        undoThisRound("passed rules 1-5, then, refitted without the earlier finding it displaced, its parameter moved to where its "
                   "interval reaches the no-effect value");
         return true;
     }

@@ -75,9 +75,10 @@ private:
     /// Every earlier finding must still earn its place beside this round's; the weakest that does
     /// not (or one the joint refit moved to its no-effect value) is dropped, one at a time.
     void askEarlierFindings();
-    void record(const Without& w, const std::string& verdict);
+    /// A trial row for an earlier finding asked beside this round's: kept or dropped, and why.
+    void recordWithout(const Without& w, const std::string& verdict);
     /// The report and the model go back to where the round began.
-    void undoRound(const std::string& verdict);
+    void undoThisRound(const std::string& verdict);
 
     Diagnosis& d_;
     const Engine& engine_;
