@@ -27,6 +27,7 @@
 #include <Eigen/QR>
 
 #include "DiagnoseEngine.h" // lab/src: the Gauss-Newton move behind the rig unknowns
+#include "DiagnoseRounds.h" // lab/src: the naming rounds and the rules they print
 
 using namespace rosin::lab;
 namespace fs = std::filesystem;
@@ -1224,6 +1225,38 @@ TEST(DiagnoseParameters, RuleFoursWeakestNameableValuesFollowTheModelDiscrepancy
     for (auto& [name, sd] : half.modelDiscrepancy) sd *= 0.5;
     EXPECT_NEAR(*diag::nameableEdge(half, "shift_k"), 1.96 * 4.0, 0.01);
     EXPECT_NEAR(*diag::nameableEdge(half, "zt_ratio"), 7.5 / (1.0 + 1.96 * 0.265), 0.01);
+}
+
+// The rules diagnosis.json prints are the ones the rounds apply: they carry the options' naming
+// threshold and margins, the manifest's stated priors, and the pair rule only when pairs are tried.
+TEST(DiagnoseRules, TheRulesTextCarriesTheOptionsThresholdsAndTheManifestsPriors)
+{
+    const auto holds = [](const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; };
+    diag::StringInfo silent;
+    const DiagnoseOptions shipped;
+    const auto rules = diag::NamingRounds::rules(shipped, silent);
+    ASSERT_EQ(rules.size(), 5u); // calibration, rules 1-5, after a finding, the gain, rule 6
+    EXPECT_TRUE(holds(rules[0], "tension within +-5 % and bow position within +-4 % of the manifest")) << rules[0];
+    EXPECT_FALSE(holds(rules[0], "stated prior"));
+    EXPECT_TRUE(holds(rules[1], "the fall is at least 5 % of the validation error")) << rules[1];
+    EXPECT_TRUE(holds(rules[1], "a rosin shift below the rate dependence by 30 %"));
+    EXPECT_TRUE(holds(rules[1], "no shift under 15.7 K"));
+    EXPECT_TRUE(holds(rules[2], "the round is undone"));
+    EXPECT_FALSE(std::any_of(rules.begin(), rules.end(), [&](const std::string& r) { return holds(r, "tried together as one candidate"); }));
+
+    diag::StringInfo stated;
+    stated.tensionPrior = 0.01;
+    DiagnoseOptions other = shipped;
+    other.namingThreshold = 0.08;
+    other.shiftOverRateMargin = 0.05; // under the threshold: no margin of its own
+    other.tryPairs = true;
+    other.usualResidualRatio = 0.0;
+    const auto changed = diag::NamingRounds::rules(other, stated);
+    ASSERT_EQ(changed.size(), 5u); // the pair rule in, rule 6 out
+    EXPECT_TRUE(holds(changed[0], "tension within +-1 % (the manifest's stated prior) and bow position within +-4 %")) << changed[0];
+    EXPECT_TRUE(holds(changed[1], "the fall is at least 8 % of the validation error"));
+    EXPECT_FALSE(holds(changed[1], "a rosin shift below the rate dependence by"));
+    EXPECT_TRUE(holds(changed[4], "tried together as one candidate"));
 }
 
 // A rosin shift and the bow side's effusivity (a nuisance within 300-600 W s^1/2 m^-2 K^-1) both
