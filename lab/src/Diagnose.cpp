@@ -14,7 +14,7 @@
 
 namespace rosin::lab {
 
-using diag::has;
+using namespace diag;
 
 std::string EffectModel::name() const
 {
@@ -53,8 +53,6 @@ const std::vector<std::string>& physicalParameterNames()
     }();
     return names;
 }
-
-using namespace diag;
 
 Diagnosis diagnose(const MeasurementSet& set, const DiagnoseOptions& o, const std::function<void(const std::string&, double)>& progress)
 {

@@ -91,7 +91,8 @@ NamingRounds::Tried NamingRounds::evaluate(const Candidate& c, std::vector<doubl
     trial.gain = t.gain[0];
     trial.gainLow = t.gain[1];
     trial.gainHigh = t.gain[2];
-    trial.relativeGain = valBefore_ > 0 ? t.gain[0] / valBefore_ : 0.0;
+    const double before = mean(currentVal_); // the round's start: no candidate has been kept yet
+    trial.relativeGain = before > 0 ? t.gain[0] / before : 0.0;
     trial.verdict = "not the largest fall";
     if (!(t.gain[1] > 0.0)) trial.verdict = "validation fall not significant";
     else if (trial.relativeGain < o_.namingThreshold) trial.verdict = "validation fall below the threshold";
@@ -368,7 +369,6 @@ bool NamingRounds::nextRound()
     for (const Candidate& c : candidates(current_))
         if (!dropped_.count(c.effect)) cands.push_back(withNuisances(c, current_));
     if (cands.empty()) return false;
-    valBefore_ = mean(currentVal_);
     for (std::size_t k = 0; k < cands.size(); ++k) {
         say_("round " + std::to_string(round_) + ": " + cands[k].effect, static_cast<double>(k) / static_cast<double>(cands.size()));
         double fitError = 0;

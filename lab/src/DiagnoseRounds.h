@@ -96,7 +96,6 @@ private:
     // What a round knows while it runs (reset at its start).
     std::vector<Tried> tried_, pairs_;
     const Tried* best_ = nullptr;
-    double valBefore_ = 0;                                       ///< the validation error the round starts from
     std::map<std::string, double> halfWidth_;                    ///< the judged candidate's bootstrap half-widths
     std::map<std::string, std::array<double, 2>> halvesOffset_; ///< the named candidate's halves, from its value
     std::map<std::string, double> roundValidation_;             ///< every candidate's validation error this round
