@@ -277,6 +277,7 @@ TEST(RosinCli, BadArgumentsFailClearlyAndWriteNothing)
         {"diagnose some-set --model-discrepancy p=0.1x" + out, "--model-discrepancy p=0.1x"}, // trailing text, once read as 0.1
         {"diagnose some-set --model-discrepancy tension_scale=11" + out, "--model-discrepancy tension_scale=11"},
         {"study --pool /nonexistent-study" + out, "/nonexistent-study"},
+        {"study --compare-splits /nonexistent-study" + out, "/nonexistent-study"},
         {"diagnose some-set --shift-margin 1.5" + out, "--shift-margin"},
         {"diagnose some-set --shift-margin nan" + out, "--shift-margin"},
         {"render --set tension_n=60N" + out, "--set tension_n: '60N' is not a number"},

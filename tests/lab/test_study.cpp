@@ -1070,3 +1070,92 @@ TEST(Study, StudiesOfSeveralSeedsScoreAsOneAndRefuseWhatWouldMakeThePoolLie)
     EXPECT_EQ(alone["sets"][0]["study"], "");
     for (const auto& d : {a, b, out}) fs::remove_all(d);
 }
+
+// One plan's sets diagnosed under three splits, side by side (`study --compare-splits`): a set
+// counts as alike only when every split names the same effects, an effect is counted as named
+// under every split, some or none, a wrong label under any one split is counted, and each split's
+// exact count and coverage are its own. What would make the comparison meaningless is refused.
+TEST(Study, TheSameSetsUnderSeveralSplitsAreComparedSetBySet)
+{
+    const fs::path a = freshDir("splits-a"), b = freshDir("splits-b"), c = freshDir("splits-c"), out = freshDir("splits-out");
+    const auto truth = [](json t, std::uint64_t seed) { t["seed"] = seed; return t; };
+    const auto writeSplit = [](const fs::path& folder, int index, std::uint64_t seed) {
+        std::ofstream(setDir(folder, index) / "diagnosis" / "split.json") << json{{"seed", seed}, {"method", "random"}}.dump();
+    };
+    const json nothing{{"effects", json::array()}, {"params", json::object()}};
+    const json contactTruth{{"effects", {"hertzian_contact"}}, {"params", {{"load_exponent", 0.67}}}};
+    const json thermalTruth{{"effects", {"thermal_memory"}}, {"params", {{"r_A", 1.0}}}};
+    const json none = diagnosis(json::array({{{"effect", "none"}}}));
+    const json contactHeld = diagnosis(json::array({finding("hertzian_contact", "load_exponent", 0.70, 0.65, 0.75)}));
+    const json contactMissed = diagnosis(json::array({finding("hertzian_contact", "load_exponent", 0.70, 0.68, 0.72)}));
+    const json thermal = diagnosis(json::array({finding("thermal_memory", "r_A", 1.02, 0.95, 1.1)}));
+    // Set 0 is null: only c names a contact there. Set 1 hides a contact: a and b name it (a's
+    // interval holds the truth, b's does not), c misses it. Set 2: all three name thermal memory.
+    writeSet(a, 0, truth(nothing, 11), none);
+    writeSet(b, 0, truth(nothing, 11), none);
+    writeSet(c, 0, truth(nothing, 11), contactHeld);
+    writeSet(a, 1, truth(contactTruth, 12), contactHeld);
+    writeSet(b, 1, truth(contactTruth, 12), contactMissed);
+    writeSet(c, 1, truth(contactTruth, 12), none);
+    for (const auto& folder : {a, b, c}) writeSet(folder, 2, truth(thermalTruth, 13), thermal);
+    writeSet(a, 3, truth(thermalTruth, 14), thermal); // diagnosed under one split only: left out
+    for (int i : {0, 1, 2, 3}) writeSplit(a, i, 1);
+    for (int i : {0, 1, 2}) writeSplit(b, i, 2);
+    for (int i : {0, 1, 2}) writeSplit(c, i, 30 + static_cast<std::uint64_t>(i)); // a split per set
+    for (const auto& folder : {a, b, c}) std::ofstream(folder / "plan.json") << json{{"grid", 12}, {"seed", 5}, {"sets", json::array()}}.dump();
+
+    const std::string md = compareSplits(out, {a, b, c});
+    json r;
+    std::ifstream(out / "splits.json") >> r;
+    EXPECT_EQ(r["sets_compared"], 3);
+    EXPECT_EQ(r["sets_left_out"], 1);
+    EXPECT_EQ(r["sets_alike"], 1) << "only set 2 is named alike under every split";
+    EXPECT_EQ(r["null_sets"], 1);
+    EXPECT_EQ(r["null_sets_naming_under_any"], 1);
+    EXPECT_EQ(r["effects"]["hertzian_contact"],
+              json({{"hidden", 1}, {"named_under_every_split", 0}, {"named_under_some", 1}, {"named_under_none", 0}, {"named_where_not_hidden_under_any", 1}}));
+    EXPECT_EQ(r["effects"]["thermal_memory"]["named_under_every_split"], 1);
+    EXPECT_EQ(r["effects"]["thermal_memory"]["named_where_not_hidden_under_any"], 0);
+    ASSERT_EQ(r["studies"].size(), 3u);
+    EXPECT_EQ(r["studies"][0]["exactly_right"], 3);
+    EXPECT_EQ(r["studies"][2]["exactly_right"], 1);
+    EXPECT_EQ(r["studies"][2]["labels_where_not_hidden"], 1);
+    EXPECT_EQ(r["studies"][0]["covered"], 2);
+    EXPECT_EQ(r["studies"][1]["covered"], 1) << "b's contact interval misses 0.67";
+    EXPECT_EQ(r["studies"][1]["intervals"], 2);
+    EXPECT_EQ(r["studies"][2]["intervals"], 1) << "a contact named on a null set has no truth to hold";
+    EXPECT_EQ(r["coverage"], json({{"covered", 4}, {"intervals", 5}}));
+    EXPECT_EQ(r["studies"][0]["split"], "one split for every set, seed 1");
+    EXPECT_EQ(r["studies"][2]["split"], "a split per set, 3 seeds over 3 sets");
+    EXPECT_NE(md.find("Sets named alike under every split: 1 of 3 (33 %)"), std::string::npos) << md;
+    EXPECT_NE(md.find("| 1 | hertzian_contact | hertzian_contact | hertzian_contact | none |"), std::string::npos) << md;
+    EXPECT_NE(md.find("(1 more diagnosed in some only, left out)"), std::string::npos) << md;
+
+    const auto refusal = [&](const fs::path& into, const std::vector<fs::path>& studies) {
+        try {
+            compareSplits(into, studies);
+        } catch (const LabError& e) {
+            return std::string(e.what());
+        }
+        return std::string("compared");
+    };
+    EXPECT_NE(refusal(out, {a}).find("two or more"), std::string::npos);
+    EXPECT_NE(refusal(a, {a, b}).find("would be written into a study it compares"), std::string::npos);
+    // The same split under two names compares nothing.
+    writeSplit(c, 2, 1);
+    const std::string twice = refusal(out, {a, b, c});
+    EXPECT_NE(twice.find("split seed 1, as in " + a.string()), std::string::npos) << twice;
+    EXPECT_NE(twice.find(setDir(c, 2).string() + "/diagnosis/split.json"), std::string::npos) << twice;
+    writeSplit(c, 2, 32);
+    // Another plan's sets, or another metric, is not another split.
+    std::ofstream(c / "plan.json") << json{{"grid", 12}, {"seed", 6}, {"sets", json::array()}}.dump();
+    EXPECT_NE(refusal(out, {a, b, c}).find("splits are compared on one plan's sets"), std::string::npos);
+    std::ofstream(c / "plan.json") << json{{"grid", 12}, {"seed", 5}, {"sets", json::array()}}.dump();
+    json weighted = thermal;
+    weighted["metric_weights"] = {0.3, 0.3, 0.3, 0.0, 0.1};
+    writeSet(c, 2, truth(thermalTruth, 13), weighted);
+    EXPECT_NE(refusal(out, {a, b, c}).find("splits compared must use one metric"), std::string::npos);
+    writeSet(c, 2, truth(thermalTruth, 13), thermal);
+    EXPECT_EQ(refusal(out, {a, b, c}), "compared");
+    for (const auto& d : {a, b, c, out}) fs::remove_all(d);
+}

@@ -22,6 +22,7 @@ struct StudyCommand {
     std::vector<std::string> paramRanges;
     std::vector<std::string> statedUncertainties;
     std::vector<std::string> pool;
+    std::vector<std::string> compare;
 
     CLI::App* add(CLI::App& app)
     {
@@ -79,6 +80,12 @@ struct StudyCommand {
                         "none of them")
             ->check(CLI::ExistingDirectory)
             ->excludes("--only", "--hiding", "--generate-only", "--keep-sets", "--score-only");
+        cmd->add_option("--compare-splits", compare,
+                        "Set these finished studies of one plan, each diagnosed under another split (--diagnose-seed, --split-per-set), "
+                        "side by side into OUT/splits.md and splits.json: the sets named alike under every split, each effect named "
+                        "under every split, some or none, and each split's coverage; runs no set")
+            ->check(CLI::ExistingDirectory)
+            ->excludes("--pool", "--only", "--hiding", "--generate-only", "--keep-sets", "--score-only");
         cmd->add_flag("-q,--quiet", options.quiet, "No progress and no summary");
         return cmd;
     }
@@ -88,6 +95,12 @@ struct StudyCommand {
         options.rig = parseRigValues(rigValues);
         options.paramRanges = parseParamRanges(paramRanges);
         options.statedUncertainty = parseStatedUncertainties(statedUncertainties);
+        if (!compare.empty()) {
+            if (!Distributed::instance().isRoot()) return 0;
+            const std::string summary = compareSplits(out, std::vector<std::filesystem::path>(compare.begin(), compare.end()));
+            if (!options.quiet) std::printf("%s\nwrote %s/splits.md, splits.json\n", summary.c_str(), out.c_str());
+            return 0;
+        }
         if (!pool.empty()) {
             if (!Distributed::instance().isRoot()) return 0;
             const std::string summary = scoreStudies(out, std::vector<std::filesystem::path>(pool.begin(), pool.end()));

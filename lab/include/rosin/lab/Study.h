@@ -91,4 +91,11 @@ std::string scoreStudy(const std::filesystem::path& dir);
 /// detection against size, the coverage and the usual residual better than any one study.
 std::string scoreStudies(const std::filesystem::path& dir, const std::vector<std::filesystem::path>& studies);
 
+/// Sets the same plan's sets diagnosed under several splits (one study folder per split) side by
+/// side: how many are named alike under every split, each effect named under every split, some or
+/// none, labels where nothing was hidden under any split, and each split's exact count and
+/// coverage. Writes `dir`/splits.md and splits.json (dir must be none of the studies) and returns
+/// the markdown. The studies must share plan and procedure and differ in their split.
+std::string compareSplits(const std::filesystem::path& dir, const std::vector<std::filesystem::path>& studies);
+
 } // namespace rosin::lab
