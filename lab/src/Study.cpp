@@ -75,13 +75,14 @@ json readJsonFile(const fs::path& file)
     return j;
 }
 
+} // namespace
+
 fs::path setFolder(const fs::path& dir, int index)
 {
     char name[16];
     std::snprintf(name, sizeof name, "%03d", index);
     return dir / "sets" / name;
 }
-} // namespace
 
 json readPlan(const fs::path& dir) { return fs::exists(dir / "plan.json") ? readJsonFile(dir / "plan.json") : json(); }
 

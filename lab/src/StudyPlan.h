@@ -13,6 +13,8 @@ namespace rosin::lab {
 
 /// DIR/plan.json, or null when the folder has none; an unreadable one is refused naming the file.
 nlohmann::json readPlan(const std::filesystem::path& dir);
+/// The folder a study keeps set `index` in (DIR/sets/NNN).
+std::filesystem::path setFolder(const std::filesystem::path& dir, int index);
 
 /// What a set's diagnosis/split.json says of its split: the seed (0 where none was written) and
 /// the method (diagnoses from before the stratified split wrote none and were all "random").

@@ -253,7 +253,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
     std::string sources;
     std::vector<Scored> sets;
     for (const fs::path& study : studies) {
-        if (!fs::is_directory(study / "sets")) throw LabError(study.string() + ": no sets/ folder (run the study first)");
+        const std::vector<fs::path> folders = diagnosedSetFolders(study);
         if (pooled && fs::exists(dir) && fs::equivalent(dir, study))
             throw LabError(dir.string() + ": the pooled summary would overwrite the summary of a study it pools; write it to another folder");
         const json here = readPlan(study);
@@ -261,11 +261,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
             throw LabError(study.string() + "/plan.json: " + populationOf(here).dump() + " where " + studies.front().string() + " has " +
                            populationOf(plan).dump() + ": studies scored together must share the grid, gesture, units, generator, fixed rig values, parameter ranges and stated uncertainties");
         const std::size_t before = sets.size();
-        std::vector<fs::path> folders;
-        for (const auto& e : fs::directory_iterator(study / "sets")) folders.push_back(e.path());
-        std::sort(folders.begin(), folders.end());
         for (const fs::path& f : folders) {
-            if (!fs::exists(f / "diagnosis" / "diagnosis.json") || !fs::exists(f / "truth.json")) continue;
             Scored s = readScored(f);
             if (pooled) s.study = study.filename().string();
             if (!s.units.empty()) {

@@ -8,6 +8,7 @@
 
 #include "DiagnoseEngine.h"
 #include "StudyPlan.h"
+#include "rosin/lab/Error.h"
 #include "rosin/lab/Plot.h"
 #include "rosin/lab/Study.h"
 #include "rosin/lab/SynthData.h"
@@ -46,6 +47,16 @@ double usualResidualOf(const std::vector<double>& sortedNullOverFloor)
     const std::size_t n = sortedNullOverFloor.size();
     const std::size_t rank = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n) - 1e-9));
     return sortedNullOverFloor[std::clamp<std::size_t>(rank, 1, n) - 1];
+}
+
+std::vector<fs::path> diagnosedSetFolders(const fs::path& study)
+{
+    if (!fs::is_directory(study / "sets")) throw LabError(study.string() + ": no sets/ folder (run the study first)");
+    std::vector<fs::path> folders;
+    for (const auto& e : fs::directory_iterator(study / "sets"))
+        if (fs::exists(e.path() / "diagnosis" / "diagnosis.json") && fs::exists(e.path() / "truth.json")) folders.push_back(e.path());
+    std::sort(folders.begin(), folders.end());
+    return folders;
 }
 
 Scored readScored(const fs::path& f)

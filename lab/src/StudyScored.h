@@ -70,6 +70,9 @@ struct Scored {
     std::array<double, 5> metricWeights = ErrorParts::kWeights; ///< diagnosis.json's metric weights
 };
 
+/// A study's set folders (DIR/sets/NNN) that hold both a truth and a diagnosis, in order;
+/// throws naming `study` when it has no sets/ folder.
+std::vector<std::filesystem::path> diagnosedSetFolders(const std::filesystem::path& study);
 /// One set's truth and diagnosis, as the scoring needs them (`f` is DIR/sets/NNN).
 Scored readScored(const std::filesystem::path& f);
 /// study.png: detection and false positives per effect, and detection against effect size.

@@ -30,14 +30,6 @@ std::string percent(int part, int whole)
     return b;
 }
 
-/// A set's folder name, NNN.
-std::string fmtIndex(int index)
-{
-    char b[16];
-    std::snprintf(b, sizeof b, "%03d", index);
-    return b;
-}
-
 std::vector<std::string> sorted(std::vector<std::string> v)
 {
     std::sort(v.begin(), v.end());
@@ -70,14 +62,9 @@ std::pair<int, int> coverageOf(const Scored& s)
 
 SplitStudy readSplitStudy(const fs::path& study)
 {
-    if (!fs::is_directory(study / "sets")) throw LabError(study.string() + ": no sets/ folder (run the study first)");
     SplitStudy out;
     out.name = study.filename().string();
-    std::vector<fs::path> folders;
-    for (const auto& e : fs::directory_iterator(study / "sets")) folders.push_back(e.path());
-    std::sort(folders.begin(), folders.end());
-    for (const fs::path& f : folders) {
-        if (!fs::exists(f / "diagnosis" / "diagnosis.json") || !fs::exists(f / "truth.json")) continue;
+    for (const fs::path& f : diagnosedSetFolders(study)) {
         Scored s = readScored(f);
         if (s.seed == 0) throw LabError(f.string() + "/truth.json: no \"seed\": its set cannot be matched with the other studies' sets");
         out.splitSeeds.insert(s.splitSeed);
@@ -96,7 +83,7 @@ void requireOneProcedure(const std::vector<SplitStudy>& studies, const std::vect
     const Scored& first = studies.front().sets.begin()->second;
     for (std::size_t k = 0; k < studies.size(); ++k)
         for (const auto& [seed, s] : studies[k].sets) {
-            const std::string where = folders[k].string() + "/sets/" + fmtIndex(s.index);
+            const std::string where = setFolder(folders[k], s.index).string();
             if (s.splitMethod != first.splitMethod)
                 throw LabError(where + "/diagnosis/split.json: method \"" + s.splitMethod + "\" where " + folders.front().string() + " has \"" +
                                first.splitMethod + "\": splits compared must deal the strokes the same way");
@@ -140,7 +127,7 @@ std::string compareSplits(const fs::path& dir, const std::vector<fs::path>& fold
         for (std::size_t k = 0; k < studies.size(); ++k) {
             const Scored& s = studies[k].sets.at(seed);
             if (const auto [at, fresh] = splitOf.emplace(s.splitSeed, folders[k].string()); !fresh)
-                throw LabError(folders[k].string() + "/sets/" + fmtIndex(s.index) + "/diagnosis/split.json: split seed " + std::to_string(s.splitSeed) +
+                throw LabError(setFolder(folders[k], s.index).string() + "/diagnosis/split.json: split seed " + std::to_string(s.splitSeed) +
                                ", as in " + at->second + ": the same split twice compares nothing");
         }
     }
