@@ -129,6 +129,25 @@ std::string findingCaveats(const Finding& f, std::optional<double> statedSpeedRa
 std::string describe(const std::string& effect, const std::vector<ErrorParts>& before, const std::vector<ErrorParts>& after,
                      const std::vector<std::size_t>& ids, const EffectModel& from, double errBefore, double errAfter);
 
+/// A fit of one effect alone, made in the round that named it with another.
+struct AloneFit {
+    EffectModel model;
+    std::vector<ErrorParts> val;
+};
+/// A finding's evidence and the validation errors it compares.
+struct FindingEvidence {
+    std::string text;
+    double before = 0, after = 0;
+};
+/// The evidence for `effect`, one of the effects a round named together (`named`). Alone, it is
+/// the round's start against its end. A candidate that brings thermal memory along (a rate law or
+/// a rosin shift bends the thermal law) is told apart with the round's fit of thermal memory
+/// alone: thermal memory from the round's start to that fit, the other effect from there to the
+/// end, so each finding says what it added. A pair says what each of the two did alone.
+FindingEvidence roundEvidence(const std::string& effect, const std::vector<std::string>& named, const std::map<std::string, AloneFit>& alone,
+                              const std::vector<ErrorParts>& atStart, const std::vector<ErrorParts>& atEnd, const std::vector<std::size_t>& ids,
+                              const EffectModel& from);
+
 /// Step 1 of a diagnosis: every recording low-passed, cleaned (DC always; mains hum where most
 /// recordings show it), its gesture start found from the pre-slip ramp, one scale for the set;
 /// what was taken out goes into d.calibration, what had to be assumed into d.warnings.

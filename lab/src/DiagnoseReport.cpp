@@ -51,6 +51,38 @@ std::string describe(const std::string& effect, const std::vector<ErrorParts>& b
     return buf;
 }
 
+FindingEvidence roundEvidence(const std::string& effect, const std::vector<std::string>& named, const std::map<std::string, AloneFit>& alone,
+                              const std::vector<ErrorParts>& atStart, const std::vector<ErrorParts>& atEnd, const std::vector<std::size_t>& ids,
+                              const EffectModel& from)
+{
+    const double start = mean(atStart), end = mean(atEnd);
+    FindingEvidence e{describe(effect, atStart, atEnd, ids, from, start, end), start, end};
+    if (named.size() < 2) return e;
+    std::vector<std::string> others;
+    for (const auto& n : named)
+        if (n != effect) others.push_back(n);
+    std::string otherText;
+    for (std::size_t k = 0; k < others.size(); ++k) otherText += (k == 0 ? "" : k + 1 == others.size() ? " and " : ", ") + others[k];
+    const auto thermal = alone.find("thermal_memory");
+    if (has(named, "thermal_memory") && thermal != alone.end()) {
+        const double mid = mean(thermal->second.val);
+        if (effect == "thermal_memory")
+            return {describe(effect, atStart, thermal->second.val, ids, from, start, mid) + " That is thermal memory alone, fitted in the same round; " +
+                        otherText + " came with it as one candidate, and its finding says what it adds beyond this.",
+                    start, mid};
+        return {describe(effect, thermal->second.val, atEnd, ids, thermal->second.model, mid, end) +
+                    " That is beyond thermal memory alone, fitted in the same round; the two came as one candidate.",
+                mid, end};
+    }
+    std::string aloneText;
+    for (const auto& n : named) {
+        const auto a = alone.find(n);
+        aloneText += a == alone.end() ? " " + n + " alone was not fitted this round." : " " + n + " alone, fitted in the same round, left it at " + fmt(mean(a->second.val), "%.3f") + ".";
+    }
+    e.text += " Named together with " + otherText + " as one candidate:" + aloneText;
+    return e;
+}
+
 // A rosin shift and the bow side's effusivity look alike in Guettler strokes. A softer rosin
 // (positive shift) starts a stroke with less static friction, which r_A takes up, and then loses
 // less of it as the contact heats (its steepest fall is behind it), which a bow that draws heat

@@ -420,12 +420,18 @@ bool NamingRounds::nextRound()
                 for (double& x2 : f.halves[name]) x2 += moved;
         }
     currentTest_ = engine_.errors(current_, testSet_);
-    const double before = mean(stepBefore_);
-    for (Finding& finding : newFindings(current_)) {
-        const std::string& effect = finding.effect;
-        finding.heldoutBefore = before;
-        finding.heldoutAfter = mean(currentVal_);
-        finding.evidence = describe(effect, stepBefore_, currentVal_, valSet_, from_, before, finding.heldoutAfter);
+    std::vector<Finding> found = newFindings(current_);
+    std::vector<std::string> named;
+    for (const Finding& f : found) named.push_back(f.effect);
+    // The round's single-effect fits tell apart what each of several effects named at once added.
+    std::map<std::string, AloneFit> alone;
+    for (const Tried& t : tried_)
+        if (has(named, t.c.effect)) alone[t.c.effect] = {apply(from_, t.c, t.x), t.val};
+    for (Finding& finding : found) {
+        FindingEvidence e = roundEvidence(finding.effect, named, alone, stepBefore_, currentVal_, valSet_, from_);
+        finding.evidence = std::move(e.text);
+        finding.heldoutBefore = e.before;
+        finding.heldoutAfter = e.after;
         d_.findings.push_back(std::move(finding));
     }
     return true;

@@ -91,10 +91,11 @@ Diagnosis diagnoseModelSet(const Case& k, SynthTruth& truth)
     return diagnose(modelSetFromDisk(spec, truth), o);
 }
 
-void check(const Case& k)
+void check(const Case& k, Diagnosis* diagnosed = nullptr)
 {
     SynthTruth truth;
     const Diagnosis d = diagnoseModelSet(k, truth);
+    if (diagnosed) *diagnosed = d;
 
     std::vector<std::string> found;
     for (const auto& f : d.findings) found.push_back(f.effect);
@@ -1156,7 +1157,74 @@ TEST(DiagnoseConsistency, ReportsNoneWhenTheBaselineMadeTheData) { check({{}, 21
 
 TEST(DiagnoseConsistency, FindsHertzianContactAtAnotherRateWithAnotherReflectionDesign) { check({{"hertzian_contact"}, 27, 44100, true}); }
 
-TEST(DiagnoseConsistency, FindsThermalMemoryWithARosinTemperatureShift) { check({{"rosin_temperature_shift"}, 25}); }
+// A shift comes with thermal memory as one candidate (it bends the thermal law), so one round
+// names both; each finding says what it added, told apart by the round's fit of thermal memory
+// alone, whose validation error the trials table holds (the round's start less its fall).
+TEST(DiagnoseConsistency, FindsThermalMemoryWithARosinTemperatureShift)
+{
+    Diagnosis d;
+    check({{"rosin_temperature_shift"}, 25}, &d);
+    ASSERT_EQ(d.findings.size(), 2u);
+    const auto named = [&](const std::string& e) { return *std::find_if(d.findings.begin(), d.findings.end(), [&](const Finding& f) { return f.effect == e; }); };
+    const Finding thermal = named("thermal_memory"), shift = named("rosin_temperature_shift");
+    const auto aloneTrial = std::find_if(d.trials.begin(), d.trials.end(), [](const Trial& t) { return t.round == 1 && t.effect == "thermal_memory"; });
+    ASSERT_NE(aloneTrial, d.trials.end());
+    EXPECT_NEAR(thermal.heldoutAfter, thermal.heldoutBefore - aloneTrial->gain, 1e-9 * thermal.heldoutBefore);
+    EXPECT_DOUBLE_EQ(shift.heldoutBefore, thermal.heldoutAfter);
+    EXPECT_LT(thermal.heldoutAfter, thermal.heldoutBefore);
+    // rule 2: the shift fell below thermal memory alone by the naming threshold
+    EXPECT_LT(shift.heldoutAfter, (1.0 - DiagnoseOptions{}.namingThreshold) * shift.heldoutBefore);
+    EXPECT_EQ(shift.evidence.rfind("With the thermal model ", 0), 0u) << shift.evidence;
+    EXPECT_NE(shift.evidence.find("beyond thermal memory alone, fitted in the same round"), std::string::npos) << shift.evidence;
+    EXPECT_EQ(thermal.evidence.rfind("With the friction_curve model ", 0), 0u) << thermal.evidence;
+    EXPECT_NE(thermal.evidence.find("rosin_temperature_shift came with it as one candidate"), std::string::npos) << thermal.evidence;
+}
+
+// Effects named alone or as a pair keep the round's start and end; a pair also says what each
+// did alone, and a missing single fit is said, not invented.
+TEST(DiagnoseParameters, EachEffectARoundNamesSaysWhatItAdded)
+{
+    const auto parts = [](double jump, std::size_t n) {
+        ErrorParts e;
+        e.jump = jump;
+        return std::vector<ErrorParts>(n, e);
+    };
+    const std::vector<std::size_t> ids{0, 1, 2, 3};
+    const std::vector<ErrorParts> start = parts(0.8, 4), end = parts(0.2, 4);
+    EffectModel baseline;
+    const auto single = diag::roundEvidence("hertzian_contact", {"hertzian_contact"}, {}, start, end, ids, baseline);
+    EXPECT_DOUBLE_EQ(single.before, 0.2);
+    EXPECT_DOUBLE_EQ(single.after, 0.05);
+    EXPECT_EQ(single.text.find("alone"), std::string::npos) << single.text;
+    EXPECT_NE(single.text.find("first-slip jumps of the 4 held-out strokes were off by 80.0 % of the bow force on average; they are off by 20.0 %"),
+              std::string::npos)
+        << single.text;
+
+    EffectModel thermalOnly;
+    thermalOnly.effects = {"thermal_memory"};
+    const std::map<std::string, diag::AloneFit> alone{{"thermal_memory", {thermalOnly, parts(0.5, 4)}}};
+    const std::vector<std::string> both{"rate_dependence", "thermal_memory"};
+    const auto thermal = diag::roundEvidence("thermal_memory", both, alone, start, end, ids, baseline);
+    const auto rate = diag::roundEvidence("rate_dependence", both, alone, start, end, ids, baseline);
+    EXPECT_DOUBLE_EQ(thermal.before, 0.2);
+    EXPECT_DOUBLE_EQ(thermal.after, 0.125);
+    EXPECT_DOUBLE_EQ(rate.before, 0.125);
+    EXPECT_DOUBLE_EQ(rate.after, 0.05);
+    EXPECT_NE(thermal.text.find("off by 80.0 % of the bow force on average; they are off by 50.0 %"), std::string::npos) << thermal.text;
+    EXPECT_NE(rate.text.find("With the thermal model the first-slip jumps of the 4 held-out strokes were off by 50.0 %"), std::string::npos) << rate.text;
+    EXPECT_NE(rate.text.find("beyond thermal memory alone, fitted in the same round; the two came as one candidate."), std::string::npos) << rate.text;
+    EXPECT_NE(thermal.text.find("rate_dependence came with it as one candidate"), std::string::npos) << thermal.text;
+
+    const std::vector<std::string> pair{"hertzian_contact", "torsional_compliance"};
+    const std::map<std::string, diag::AloneFit> oneAlone{{"hertzian_contact", {baseline, parts(0.6, 4)}}};
+    const auto contact = diag::roundEvidence("hertzian_contact", pair, oneAlone, start, end, ids, baseline);
+    EXPECT_DOUBLE_EQ(contact.before, 0.2);
+    EXPECT_DOUBLE_EQ(contact.after, 0.05);
+    EXPECT_NE(contact.text.find("Named together with torsional_compliance as one candidate: hertzian_contact alone, fitted in the same round, left it "
+                                "at 0.150. torsional_compliance alone was not fitted this round."),
+              std::string::npos)
+        << contact.text;
+}
 
 // Rule 4 asks the interval the report prints, model discrepancy included, to exclude no effect.
 // The seed-25 set above hides a -19.9 K shift, named with the default discrepancy (8 K, a
