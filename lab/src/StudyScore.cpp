@@ -59,13 +59,13 @@ void scoreParameters(std::ostringstream& md, json& summary, const std::vector<Sc
             const double e = tol.relative ? std::abs(v / t - 1.0) : std::abs(v - t);
             err.push_back(e);
             within += e <= tol.value;
-            // An interval as wide as the search range holds any truth and says nothing: such a
-            // parameter is counted apart, not as covered.
-            if (s.unidentified.count(p)) {
+            // A parameter not identified is counted apart, not as covered (truthInInterval).
+            const auto covers = truthInInterval(s, p);
+            if (!covers) {
                 ++unidentified;
                 continue;
             }
-            const bool in = t >= s.estimate.at(p)[1] && t <= s.estimate.at(p)[2];
+            const bool in = *covers;
             inside += in;
             covered += in;
             ++intervals;

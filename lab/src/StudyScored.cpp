@@ -49,6 +49,13 @@ double usualResidualOf(const std::vector<double>& sortedNullOverFloor)
     return sortedNullOverFloor[std::clamp<std::size_t>(rank, 1, n) - 1];
 }
 
+std::optional<bool> truthInInterval(const Scored& s, const std::string& p)
+{
+    if (!s.truth.count(p) || !s.estimate.count(p) || !has(s.found, effectOfParameter(p)) || s.unidentified.count(p)) return std::nullopt;
+    const double t = s.truth.at(p);
+    return t >= s.estimate.at(p)[1] && t <= s.estimate.at(p)[2];
+}
+
 std::vector<fs::path> diagnosedSetFolders(const fs::path& study)
 {
     if (!fs::is_directory(study / "sets")) throw LabError(study.string() + ": no sets/ folder (run the study first)");

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -69,6 +70,11 @@ struct Scored {
     std::map<std::string, bool> search; ///< diagnosis.json's search switches (empty: not recorded)
     std::array<double, 5> metricWeights = ErrorParts::kWeights; ///< diagnosis.json's metric weights
 };
+
+/// Whether named parameter p's reported 95 % interval holds its truth; nothing where the set does
+/// not count toward coverage: p not hidden or not estimated, its effect not named, or p reported
+/// as not identified (an interval as wide as the search range holds any truth and says nothing).
+std::optional<bool> truthInInterval(const Scored& s, const std::string& p);
 
 /// A study's set folders (DIR/sets/NNN) that hold both a truth and a diagnosis, in order;
 /// throws naming `study` when it has no sets/ folder.

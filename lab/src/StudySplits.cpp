@@ -52,11 +52,11 @@ struct SplitStudy {
 std::pair<int, int> coverageOf(const Scored& s)
 {
     int covered = 0, intervals = 0;
-    for (const std::string& p : physicalParameterNames()) {
-        if (!s.truth.count(p) || !s.estimate.count(p) || !has(s.found, effectOfParameter(p)) || s.unidentified.count(p)) continue;
-        covered += s.truth.at(p) >= s.estimate.at(p)[1] && s.truth.at(p) <= s.estimate.at(p)[2];
-        ++intervals;
-    }
+    for (const std::string& p : physicalParameterNames())
+        if (const auto in = truthInInterval(s, p)) {
+            covered += *in;
+            ++intervals;
+        }
     return {covered, intervals};
 }
 
