@@ -131,6 +131,66 @@ void scoreParameters(std::ostringstream& md, json& summary, const std::vector<Sc
     summary["coverage_without_halves"] = intervals ? static_cast<double>(coveredWithoutHalves) / intervals : 0.0;
 }
 
+/// A reading's error in its tolerance's unit, signed so that positive means the reading is
+/// further from no effect than the truth (a stronger effect than hidden); r_A, which has no
+/// no-effect value, is signed as read (positive: larger).
+double strongerBy(const std::string& p, double reading, double truth)
+{
+    if (p == "shift_k") return truth < 0.0 ? truth - reading : reading - truth;
+    if (p == "load_exponent") return truth - reading;
+    if (p == "zt_ratio") return 1.0 - reading / truth;
+    if (p == "p") return reading - truth;
+    return reading / truth - 1.0;
+}
+
+/// Round 1's reading of every hidden effect's parameter, named or not, beside the named ones.
+/// The parameter table above scores only what the rules named, and the rules name mostly the
+/// readings far from no effect, so a weak effect that is named tends to read strong: this table
+/// tells the estimate's own error from that choice.
+void scoreFirstReadings(std::ostringstream& md, json& summary, const std::vector<Scored>& sets)
+{
+    struct Reading {
+        double error;
+        bool named;
+    };
+    std::map<std::string, std::vector<Reading>> byParameter;
+    for (const auto& s : sets)
+        for (const auto& [p, v] : s.firstReading)
+            if (s.truth.count(p) && has(s.hidden, effectOfParameter(p)) && diag::identifiable(p))
+                byParameter[p].push_back({strongerBy(p, v, s.truth.at(p)), has(s.found, effectOfParameter(p))});
+    if (byParameter.empty()) return;
+    md << "\nFirst readings: round 1 fits every effect's candidate, named or not. The error is signed, positive where the reading is "
+          "further from no effect than the truth (r_A: larger); h0, which no data fix, is left out.\n\n"
+          "| parameter | hidden sets read in round 1 | error: median (quartiles) | within the issue's tolerance | where named: sets, median first-reading error | "
+          "where not named: sets, median first-reading error |\n|---|---|---|---|---|---|\n";
+    // nearest-rank quantile of a sorted list
+    auto at = [](const std::vector<double>& v, double q) { return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))]; };
+    for (const std::string& p : physicalParameterNames()) {
+        const auto it = byParameter.find(p);
+        if (it == byParameter.end()) continue;
+        const Tolerance tol = tolerances().at(p);
+        std::vector<double> all, named, notNamed;
+        int within = 0;
+        for (const Reading& r : it->second) {
+            all.push_back(r.error);
+            (r.named ? named : notNamed).push_back(r.error);
+            within += std::abs(r.error) <= tol.value;
+        }
+        for (auto* v : {&all, &named, &notNamed}) std::sort(v->begin(), v->end());
+        const char* unit = tol.relative ? "%+.1f %%" : "%+.3g";
+        const double k = tol.relative ? 100.0 : 1.0;
+        auto medianText = [&](const std::vector<double>& v) { return v.empty() ? std::string("-") : fmt(unit, k * at(v, 0.5)); };
+        md << "| " << p << " | " << all.size() << " | " << fmt(unit, k * at(all, 0.5)) << " (" << fmt(unit, k * at(all, 0.25)) << " to "
+           << fmt(unit, k * at(all, 0.75)) << ") | " << within << " | " << named.size() << ", " << medianText(named) << " | " << notNamed.size()
+           << ", " << medianText(notNamed) << " |\n";
+        json entry{{"read", all.size()},       {"median_error", at(all, 0.5)}, {"quartiles", {at(all, 0.25), at(all, 0.75)}},
+                   {"within_tolerance", within}, {"named", named.size()},      {"not_named", notNamed.size()}};
+        if (!named.empty()) entry["median_error_named"] = at(named, 0.5);
+        if (!notNamed.empty()) entry["median_error_not_named"] = at(notNamed, 0.5);
+        summary["first_readings"][p] = entry;
+    }
+}
+
 void scoreCalibration(std::ostringstream& md, json& summary, const std::vector<Scored>& sets)
 {
     // Nuisances: what the rig really was against what the diagnosis calibrated (not findings,
@@ -461,6 +521,7 @@ std::string scoreStudies(const fs::path& dir, const std::vector<fs::path>& studi
         summary["detection"][e] = {{"hidden", hid}, {"named", det}, {"false_positive", fp}, {"not_hidden", other}};
     }
     scoreParameters(md, summary, sets);
+    scoreFirstReadings(md, summary, sets);
     scoreCalibration(md, summary, sets);
     // Held-out error where nothing was hidden: what a good fit reaches on this rig population.
     std::vector<double> nullBase;

@@ -103,6 +103,15 @@ Scored readScored(const fs::path& f)
             }
         }
     }
+    // Every candidate is tried in round 1, so its row there reads each effect's parameter whether
+    // or not the rules named it.
+    if (d.contains("trials"))
+        for (const auto& trial : d["trials"]) {
+            if (trial.value("round", 0) != 1 || !trial.contains("parameters") || !trial.contains("effect")) continue;
+            for (const std::string& p : physicalParameterNames())
+                if (effectOfParameter(p) == trial["effect"].get<std::string>() && trial["parameters"].contains(p))
+                    s.firstReading[p] = trial["parameters"][p].get<double>();
+        }
     if (d.contains("calibration") && d["calibration"].contains("values"))
         for (const auto& [name, v] : d["calibration"]["values"].items())
             if (v["value"].is_number() && v["ci95"].size() == 2) {

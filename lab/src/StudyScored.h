@@ -44,6 +44,8 @@ struct Scored {
     std::vector<std::string> hidden, found;
     std::map<std::string, double> truth;
     std::map<std::string, std::array<double, 3>> estimate; ///< value, ci low, ci high
+    /// round 1's reading of each physical parameter, from its own effect's candidate, named or not
+    std::map<std::string, double> firstReading;
     /// the interval without the drive halves' refits (bootstrap and curvature only), where given
     std::map<std::string, std::array<double, 2>> withoutHalves;
     /// the statistical interval (bootstrap, curvature, drive halves), and that with the rig

@@ -598,6 +598,58 @@ TEST(Study, ScoresDetectionFalsePositivesErrorsAndCoverage)
     fs::remove_all(dir);
 }
 
+// Round 1 reads every hidden effect's parameter, named or not; the study scores those first
+// readings, signed toward a stronger effect, apart for named and missed effects, so a reader sees
+// how much of a named parameter's error is the rules choosing strong readings.
+TEST(Study, ScoresRoundOnesReadingOfEveryHiddenEffectNamedOrNot)
+{
+    const fs::path dir = freshDir("first-readings");
+    const auto trial = [](int round, const std::string& effect, const json& parameters) {
+        return json{{"round", round}, {"effect", effect}, {"parameters", parameters}};
+    };
+    const auto withTrials = [](json d, const json& trials) {
+        d["trials"] = trials;
+        return d;
+    };
+    // 0: a -10 K shift read -18 K in round 1 (8 K stronger) and named at -17 K.
+    writeSet(dir, 0, {{"effects", {"thermal_memory", "rosin_temperature_shift"}}, {"params", {{"r_A", 1.0}, {"shift_k", -10.0}}}},
+             withTrials(diagnosis(json::array({finding("thermal_memory", "r_A", 1.1, 0.9, 1.3), finding("rosin_temperature_shift", "shift_k", -17.0, -30.0, -2.0)})),
+                        {trial(1, "thermal_memory", {{"r_A", 1.2}}), trial(1, "rosin_temperature_shift", {{"r_A", 1.05}, {"shift_k", -18.0}}),
+                         trial(2, "rosin_temperature_shift", {{"shift_k", -25.0}})}));
+    // 1: a +12 K shift read +9 K (3 K weaker) and a 0.7 load exponent read 0.6 (0.1 stronger), neither named.
+    writeSet(dir, 1, {{"effects", {"rosin_temperature_shift", "hertzian_contact"}}, {"params", {{"shift_k", 12.0}, {"load_exponent", 0.7}}}},
+             withTrials(diagnosis(json::array({{{"effect", "none"}}})),
+                        {trial(1, "rosin_temperature_shift", {{"shift_k", 9.0}}), trial(1, "hertzian_contact", {{"load_exponent", 0.6}})}));
+    // 2: a +15 K shift read +16 K (1 K stronger, within 3 K), not named; a round-1 roll on a set
+    //    that hides none is not scored.
+    writeSet(dir, 2, {{"effects", {"rosin_temperature_shift"}}, {"params", {{"shift_k", 15.0}}}},
+             withTrials(diagnosis(json::array({{{"effect", "none"}}})),
+                        {trial(1, "rosin_temperature_shift", {{"shift_k", 16.0}}), trial(1, "torsional_compliance", {{"zt_ratio", 2.0}})}));
+
+    const std::string md = scoreStudy(dir);
+    json study;
+    std::ifstream(dir / "study.json") >> study;
+    const json& first = study["summary"]["first_readings"];
+    const json& shift = first["shift_k"];
+    EXPECT_EQ(shift["read"], 3);
+    EXPECT_DOUBLE_EQ(shift["median_error"].get<double>(), 1.0);
+    EXPECT_DOUBLE_EQ(shift["quartiles"][0].get<double>(), -3.0);
+    EXPECT_DOUBLE_EQ(shift["quartiles"][1].get<double>(), 8.0);
+    EXPECT_EQ(shift["within_tolerance"], 2);
+    EXPECT_EQ(shift["named"], 1);
+    EXPECT_DOUBLE_EQ(shift["median_error_named"].get<double>(), 8.0); // round 1's -18 K, not round 2's or the finding's
+    EXPECT_EQ(shift["not_named"], 2);
+    EXPECT_DOUBLE_EQ(shift["median_error_not_named"].get<double>(), 1.0);
+    EXPECT_NEAR(first["load_exponent"]["median_error"].get<double>(), 0.1, 1e-12);
+    EXPECT_EQ(first["load_exponent"]["within_tolerance"], 0);
+    EXPECT_FALSE(first["load_exponent"].contains("median_error_named"));
+    // r_A from thermal memory's own candidate (1.2), not from the shift's (1.05): +20 %
+    EXPECT_NEAR(first["r_A"]["median_error"].get<double>(), 0.2, 1e-12);
+    EXPECT_FALSE(first.contains("zt_ratio"));
+    EXPECT_NE(md.find("| shift_k | 3 | +1 (-3 to +8) | 2 | 1, +8 | 2, +1 |"), std::string::npos) << md;
+    fs::remove_all(dir);
+}
+
 // The calibrated nuisances are scored against the rig that made the set: tension_scale against
 // 1 + tension_error, beta_scale against 1 + beta_error, rod_effusivity_scale against the rig's
 // rod effusivity over 450 (only sets with a thermal model calibrate it), the sensor scale against
