@@ -56,8 +56,7 @@ FindingEvidence roundEvidence(const std::string& effect, const std::vector<std::
                               const EffectModel& from)
 {
     const double start = mean(atStart), end = mean(atEnd);
-    FindingEvidence e{describe(effect, atStart, atEnd, ids, from, start, end), start, end};
-    if (named.size() < 2) return e;
+    if (named.size() < 2) return {describe(effect, atStart, atEnd, ids, from, start, end), start, end};
     std::vector<std::string> others;
     for (const auto& n : named)
         if (n != effect) others.push_back(n);
@@ -79,8 +78,7 @@ FindingEvidence roundEvidence(const std::string& effect, const std::vector<std::
         const auto a = alone.find(n);
         aloneText += a == alone.end() ? " " + n + " alone was not fitted this round." : " " + n + " alone, fitted in the same round, left it at " + fmt(mean(a->second.val), "%.3f") + ".";
     }
-    e.text += " Named together with " + otherText + " as one candidate:" + aloneText;
-    return e;
+    return {describe(effect, atStart, atEnd, ids, from, start, end) + " Named together with " + otherText + " as one candidate:" + aloneText, start, end};
 }
 
 // A rosin shift and the bow side's effusivity look alike in Guettler strokes. A softer rosin
