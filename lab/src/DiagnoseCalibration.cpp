@@ -361,6 +361,30 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     return strokes;
 }
 
+std::vector<double> curvatureHalfWidths(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<double>& x,
+                                        const std::vector<std::size_t>& on)
+{
+    const auto n = static_cast<Eigen::Index>(c.names.size());
+    Eigen::VectorXd at(n), steps(n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        const auto [lo, hi] = c.names[i] == "tension_scale" || c.names[i] == "beta_scale" ? boundsOf(c.names[i], engine.info())
+                                                                                          : std::pair{c.lo[i], c.hi[i]};
+        at[k] = x[i];
+        steps[k] = 0.03 * (hi - lo); // as the final model's curvature intervals
+    }
+    auto residuals = [&](const Eigen::VectorXd& y) {
+        const auto e = engine.errors(apply(base, c, std::vector<double>(y.data(), y.data() + y.size())), on);
+        Eigen::VectorXd r(static_cast<Eigen::Index>(e.size()));
+        for (std::size_t i = 0; i < e.size(); ++i) r[static_cast<Eigen::Index>(i)] = e[i].total();
+        return r;
+    };
+    const Eigen::MatrixXd cov = curvatureCovariance(residuals, at, steps);
+    std::vector<double> hw(c.names.size());
+    for (Eigen::Index k = 0; k < n; ++k) hw[static_cast<std::size_t>(k)] = 1.96 * std::sqrt(std::max(0.0, cov(k, k)));
+    return hw;
+}
+
 void addCurvatureIntervals(Diagnosis& d, const Engine& engine, const EffectModel& current, const std::vector<std::size_t>& fitSet,
                            const StringInfo& info, const DiagnoseOptions& o, const std::function<void(const std::string&)>& say)
 {

@@ -243,6 +243,14 @@ bool pinnedAtEdge(const Candidate& c, const std::vector<double>& x);
 /// bootstrap half-width plus a tenth of its search range.
 bool halvesConsistent(const Candidate& c, const std::vector<double>& low, const std::vector<double>& high,
                       const std::map<std::string, double>& bootstrapHalfWidth);
+/// 1.96 standard deviations of the bootstrap refits for each of the candidate's own parameters;
+/// the identifiable ones whose refits all came back to the estimate (a spread under 0.1 % of the
+/// search range) are added to `returned`.
+std::vector<double> bootstrapHalfWidths(const Candidate& c, const std::vector<std::vector<double>>& refits, std::set<std::string>& returned);
+/// Why rule 5 refuses: each parameter whose halves differ by more than allowed, with both values
+/// and the allowance, and a half that fits no effect; empty when the halves agree.
+std::string halvesDisagreement(const Candidate& c, const std::vector<double>& low, const std::vector<double>& high,
+                               const std::map<std::string, double>& bootstrapHalfWidth);
 /// The coarse grid fit() starts from, as (parameter index, points) pairs: 7, 5 or 3 points on
 /// each of the candidate's own identifiable parameters (by their number), 3 on each gridAlso
 /// parameter. h0 gets none: its points would all give the same error.
@@ -345,6 +353,11 @@ std::vector<RigUnknownTrial> rigUnknownMoves(const Engine& engine, const EffectM
 /// parameter -> {move down, move up}: the largest move per property and side, properties in quadrature.
 std::map<std::string, std::array<double, 2>> movesBySide(const std::vector<RigUnknownTrial>& trials);
 
+/// 1.96 standard deviations of each of the candidate's parameters at x from the local curvature
+/// on the strokes `on` (all its parameters free together; a direction without curvature gets a
+/// huge width).
+std::vector<double> curvatureHalfWidths(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<double>& x,
+                                        const std::vector<std::size_t>& on);
 /// The final model's parameters, calibration and findings alike, get intervals from the local
 /// curvature on the fit strokes (nuisances widened by the studies' calibration discrepancy), and
 /// the findings the moves of the rig's unknowns.

@@ -263,6 +263,7 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
             if (f.curvature.count(name)) params[name]["ci95_curvature"] = f.curvature.at(name);
             if (f.halves.count(name)) params[name]["drive_halves"] = f.halves.at(name);
             params[name]["identified"] = !f.unidentified.count(name);
+            params[name]["bootstrap_at_estimate"] = f.bootstrapAtEstimate.count(name) > 0;
             if (!diag::noEffectValue(name).empty()) params[name]["clear_of_no_effect"] = diag::clearOfNoEffect(f, name);
             if (name == "zt_ratio") {
                 params[name]["torsion_speed_ratio"] = d.statedTorsionSpeedRatio.value_or(diag::assumedTorsionSpeedRatio());
@@ -398,6 +399,10 @@ void writeDiagnosis(const fs::path& dir, const Diagnosis& d, const DiagnoseOptio
         for (const auto& name : f.unidentified)
             md << "\n" << name << " is not identified: the errors do not change along it at the fit (no curvature), so its "
                << "interval is its whole search range and its value is whatever the search stopped at.\n";
+        for (const auto& name : f.bootstrapAtEstimate)
+            md << "\nThe bootstrap refits of " << name << " all came back to the estimate (the search ends in a narrow pit of the rough "
+               << "error surface), which says where the search sticks, not how well the data fix it: its bootstrap column and rules 4 "
+               << "and 5 use the local curvature's width instead.\n";
         md << "\n";
     }
     if (!d.rigUnknowns.empty()) {

@@ -52,7 +52,8 @@ std::vector<std::string> NamingRounds::rules(const DiagnoseOptions& o, const Str
             "must not have the other sign than round 1's shift candidate when that one was 10 K or more (else it stands in for the rate law's form), (3) it also lowers the error of the test strokes, "
             "(4) the 95 % interval of its parameter excludes the no-effect value (exponent 1, shift 0 K, "
             "Z_t/Z_0 >= 7.5, speed exponent <= 0.03), both the bootstrap refits' interval and that interval widened in quadrature "
-            "by the model discrepancy the studies measured (the one the report prints" + nameableEdgesText(o) + "), and (5) searched afresh on the low- and on the high-drive half of the fit strokes "
+            "by the model discrepancy the studies measured (the one the report prints" + nameableEdgesText(o) + "; where every refit came back to the estimate, "
+            "the local curvature's width stands in for the bootstrap's here and in rule 5), and (5) searched afresh on the low- and on the high-drive half of the fit strokes "
             "(bow acceleration; v0/tv for exp_speed and bow speed for exp_force strokes, each gesture split at its own median) it keeps away from the no-effect value with consistent values. Every candidate is fitted with the nuisances and the "
             "parameters of effects already named free beside its own. A parameter fitted within 1 % of either end of its search range "
             "(r_A 0.5-2, p 0.1-0.8, load exponent 0.4-1.1, shift -30 to +30 K, Z_t/Z_0 0.7-8) is a stand-in and is not named; "
@@ -172,15 +173,22 @@ bool NamingRounds::judge(const Tried& t)
         refits.push_back(std::move(refit));
     }
     halfWidth_.clear();
+    returnedToEstimate_.clear();
+    std::vector<double> width = bootstrapHalfWidths(t.c, refits, returnedToEstimate_);
+    // Refits that all came back to the estimate (a search that ends in a narrow pit of the rough
+    // surface: a contact's restart) measured where the search sticks, not what the data allow,
+    // and gave rule 5 no room at all (seed 2082/5: a load exponent of 0.615 for 0.597 refused for
+    // halves 0.16 apart). Those parameters take the local curvature's width instead.
+    if (!returnedToEstimate_.empty()) {
+        const std::vector<double> curvature = curvatureHalfWidths(engine_, current_, t.c, t.x, fitSet_);
+        for (std::size_t k = 0; k < t.c.scanned; ++k)
+            if (returnedToEstimate_.count(t.c.names[k])) width[k] = std::max(width[k], curvature[k]);
+    }
     bool atNullInterval = false, atNullWithDiscrepancy = false;
     // Rules (4) and (5) judge the candidate's own parameters; those of earlier findings and
     // the nuisances were free in the refits but were judged when they entered.
     for (std::size_t k = 0; k < t.c.scanned; ++k) {
-        double m = 0, v = 0;
-        for (const auto& r : refits) m += r[k];
-        m /= static_cast<double>(refits.size());
-        for (const auto& r : refits) v += (r[k] - m) * (r[k] - m);
-        const double hw = refits.size() > 1 ? 1.96 * std::sqrt(v / static_cast<double>(refits.size() - 1)) : 0.0;
+        const double hw = width[k];
         halfWidth_[t.c.names[k]] = hw;
         atNullInterval = atNullInterval || intervalAtNull(t.c.names[k], t.x[k] - hw, t.x[k] + hw);
         // The interval the report will print carries the model's own error on rigs it does
@@ -193,8 +201,8 @@ bool NamingRounds::judge(const Tried& t)
     if (atNullWithDiscrepancy) { trial.verdict = "interval reaches the no-effect value once the model discrepancy is counted"; return false; }
     // (5) the two drive halves of the fit strokes
     const std::vector<std::vector<double>> halves = diag::driveHalves(engine_, current_, t.c, fitSet_, strokes_, t.x, o_.maxEvaluations);
-    if (!halvesConsistent(t.c, halves[0], halves[1], halfWidth_)) {
-        trial.verdict = "not consistent on the two drive halves (bow acceleration, or the gesture's own drive)";
+    if (const std::string why = halvesDisagreement(t.c, halves[0], halves[1], halfWidth_); !why.empty()) {
+        trial.verdict = "not consistent on the two drive halves (bow acceleration, or the gesture's own drive): " + why;
         return false;
     }
     trial.verdict = "named";
@@ -245,6 +253,7 @@ std::vector<Finding> NamingRounds::newFindings(const EffectModel& model) const
                 const auto hw = halfWidth_.find(name);
                 const double w = hw != halfWidth_.end() ? hw->second : 0.0;
                 finding.parameters[name] = {v, v - w, v + w};
+                if (returnedToEstimate_.count(name)) finding.bootstrapAtEstimate.insert(name);
                 // the halves keep their offsets from the value, which the joint refit moved
                 if (const auto h = halvesOffset_.find(name); h != halvesOffset_.end()) finding.halves[name] = {v + h->second[0], v + h->second[1]};
             }
@@ -362,6 +371,7 @@ bool NamingRounds::nextRound()
     pairs_.clear();
     best_ = nullptr;
     halfWidth_.clear();
+    returnedToEstimate_.clear();
     halvesOffset_.clear();
     roundValidation_.clear();
 

@@ -96,7 +96,8 @@ private:
     // What a round knows while it runs (reset at its start).
     std::vector<Tried> tried_, pairs_;
     const Tried* best_ = nullptr;
-    std::map<std::string, double> halfWidth_;                    ///< the judged candidate's bootstrap half-widths
+    std::map<std::string, double> halfWidth_;                    ///< the judged candidate's bootstrap half-widths (the curvature's where they returned to the estimate)
+    std::set<std::string> returnedToEstimate_;                   ///< its parameters whose bootstrap refits all came back to the estimate
     std::map<std::string, std::array<double, 2>> halvesOffset_; ///< the named candidate's halves, from its value
     std::map<std::string, double> roundValidation_;             ///< every candidate's validation error this round
     EffectModel from_;                                           ///< the model before the round's winner

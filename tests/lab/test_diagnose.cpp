@@ -528,10 +528,14 @@ TEST(DiagnoseParameters, TheEdgeAndDriveHalvesRulesIgnoreTheUnidentifiedH0)
     low[0] = 0.3, high[0] = 1.2;
     low[1] = 0.40, high[1] = 0.56; // 0.16 apart, 0.17 allowed
     EXPECT_TRUE(diag::halvesConsistent(rate, low, high, width));
+    EXPECT_EQ(diag::halvesDisagreement(rate, low, high, width), "");
     high[1] = 0.58; // 0.18 apart
     EXPECT_FALSE(diag::halvesConsistent(rate, low, high, width));
+    // The refusal says which parameter, both halves' values and what was allowed.
+    EXPECT_EQ(diag::halvesDisagreement(rate, low, high, width), "p 0.4 on the low half, 0.58 on the high (0.18 apart, at most 0.17 allowed)");
     low[1] = 0.11, high[1] = 0.15; // close together, but the low half has no rate law
     EXPECT_FALSE(diag::halvesConsistent(rate, low, high, width));
+    EXPECT_EQ(diag::halvesDisagreement(rate, low, high, width), "the low half fits no effect");
 
     diag::Candidate contact = diag::withNuisances(diag::candidate("hertzian_contact", {"load_exponent"}, {0.8}), {});
     std::vector<double> y = contact.start;
@@ -631,6 +635,66 @@ TEST(DiagnoseParameters, RuleFiveSearchesEachDriveHalfAfreshWhereverTheEstimateS
         EXPECT_EQ(fromNoEffect[h][0], fromFarBelow[h][0]) << "half " << h;
         EXPECT_NEAR(fromNoEffect[h][0], hidden, 0.1) << "half " << h;
     }
+}
+
+// Bootstrap refits that all come back to the estimate (seed 2081/25's and 2082/5's contacts after
+// a restart: a spread of 2e-6) say where the search sticks, not what the data allow; rule 5 then
+// allowed halves only a tenth of the range apart and refused load exponents of 0.67 and 0.62.
+TEST(DiagnoseParameters, RefitsThatAllReturnToTheEstimateAreToldApartFromAFirmBootstrap)
+{
+    const diag::Candidate contact = diag::withNuisances(diag::candidate("hertzian_contact", {"load_exponent"}, {0.8}), {});
+    ASSERT_EQ(contact.scanned, 1u);
+    std::vector<std::vector<double>> refits(10, contact.start);
+    for (auto& r : refits) r.resize(contact.names.size(), 1.0), r[0] = 0.668823;
+    std::set<std::string> returned;
+    auto width = diag::bootstrapHalfWidths(contact, refits, returned);
+    ASSERT_EQ(width.size(), 1u);
+    EXPECT_LT(width[0], 1e-9);
+    EXPECT_EQ(returned, std::set<std::string>{"load_exponent"});
+
+    // A spread of sd 0.01 is a measurement: 1.96 sd, not marked.
+    const double offsets[10] = {-0.015, -0.01, -0.005, 0.0, 0.005, 0.01, 0.015, -0.0125, 0.0125, 0.0};
+    for (std::size_t b = 0; b < refits.size(); ++b) refits[b][0] = 0.67 + offsets[b];
+    returned.clear();
+    width = diag::bootstrapHalfWidths(contact, refits, returned);
+    double m = 0, v = 0;
+    for (double o : offsets) m += o / 10.0;
+    for (double o : offsets) v += (o - m) * (o - m) / 9.0;
+    EXPECT_NEAR(width[0], 1.96 * std::sqrt(v), 1e-12);
+    EXPECT_TRUE(returned.empty());
+
+    // h0, which no data fix, is never marked, however still its refits stand.
+    const diag::Candidate rate = diag::withNuisances(diag::candidate("rate_dependence", {"h0", "p"}, {0.6, 0.3}), {});
+    std::vector<std::vector<double>> rateRefits(10, rate.start);
+    for (std::size_t b = 0; b < rateRefits.size(); ++b) rateRefits[b].resize(rate.names.size(), 1.0), rateRefits[b][1] = 0.3 + 0.002 * static_cast<double>(b);
+    returned.clear();
+    diag::bootstrapHalfWidths(rate, rateRefits, returned);
+    EXPECT_TRUE(returned.empty());
+}
+
+// The width those parameters take instead: the local curvature on the fit strokes, which narrows
+// as strokes are added (about as one over their root) and stays well inside the search range.
+TEST(DiagnoseParameters, TheRoundsCurvatureWidthNarrowsWithMoreStrokes)
+{
+    diag::StringInfo info;
+    Diagnosis d;
+    SynthTruth truth;
+    std::vector<diag::Prepared> strokes = preparedModelSet({"hertzian_contact"}, 27, info, d, &truth);
+    const DiagnoseOptions o;
+    const diag::Engine engine(strokes, info, o.simRate, std::nullopt, false);
+    const auto contact = offered(diag::candidates(EffectModel{}), "hertzian_contact");
+    ASSERT_TRUE(contact);
+    std::vector<std::size_t> all(strokes.size()), quarter;
+    std::iota(all.begin(), all.end(), std::size_t{0});
+    for (std::size_t i = 0; i < all.size(); i += 4) quarter.push_back(i);
+    const std::vector<double> at{truth.params.at("load_exponent")};
+    const double onAll = diag::curvatureHalfWidths(engine, EffectModel{}, *contact, at, all)[0];
+    const double onQuarter = diag::curvatureHalfWidths(engine, EffectModel{}, *contact, at, quarter)[0];
+    EXPECT_GT(onAll, 1e-3);
+    EXPECT_LT(onAll, 0.1 * (contact->hi[0] - contact->lo[0]));
+    // a quarter of the strokes: twice as wide for a smooth surface; between 1.3 and 4 times here
+    EXPECT_GT(onQuarter, 1.3 * onAll);
+    EXPECT_LT(onQuarter, 4.0 * onAll);
 }
 
 // A contact and a roll tried together (seed 2056's set 36: the roll alone fitted worse than no

@@ -157,6 +157,9 @@ struct Finding {
     /// Parameters the data do not constrain: the local curvature along them is nil, so their
     /// curvature interval is their whole search range and their value says nothing.
     std::set<std::string> unidentified;
+    /// Parameters whose bootstrap refits all came back to the estimate (they measured where the
+    /// search sticks): the rules and the bootstrap interval use the local curvature's width there.
+    std::set<std::string> bootstrapAtEstimate;
     double heldoutBefore = 0, heldoutAfter = 0;            ///< validation error before and after
 };
 
