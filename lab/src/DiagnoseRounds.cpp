@@ -177,8 +177,9 @@ bool NamingRounds::judge(const Tried& t)
     std::vector<double> width = bootstrapHalfWidths(t.c, refits, returnedToEstimate_);
     // Refits that all came back to the estimate (a search that ends in a narrow pit of the rough
     // surface: a contact's restart) measured where the search sticks, not what the data allow,
-    // and gave rule 5 no room at all (seed 2082/5: a load exponent of 0.615 for 0.597 refused for
-    // halves 0.16 apart). Those parameters take the local curvature's width instead.
+    // and left rule 5 only a tenth of the range (seed 2081/25: a load exponent of 0.668 for 0.739
+    // refused for halves 0.074 apart, 0.070 allowed). Those parameters take the local
+    // curvature's width instead.
     if (!returnedToEstimate_.empty()) {
         const std::vector<double> curvature = curvatureHalfWidths(engine_, current_, t.c, t.x, fitSet_);
         for (std::size_t k = 0; k < t.c.scanned; ++k)
