@@ -361,23 +361,29 @@ std::vector<Prepared> prepareStrokes(const MeasurementSet& set, const StringInfo
     return strokes;
 }
 
+namespace {
+/// The curvature's residuals: each stroke's total error.
+Eigen::VectorXd strokeTotals(const std::vector<ErrorParts>& e)
+{
+    Eigen::VectorXd r(static_cast<Eigen::Index>(e.size()));
+    for (std::size_t i = 0; i < e.size(); ++i) r[static_cast<Eigen::Index>(i)] = e[i].total();
+    return r;
+}
+} // namespace
+
 std::vector<double> curvatureHalfWidths(const Engine& engine, const EffectModel& base, const Candidate& c, const std::vector<double>& x,
                                         const std::vector<std::size_t>& on)
 {
+    const Candidate searched = withinSetPriors(c, engine.info());
     const auto n = static_cast<Eigen::Index>(c.names.size());
     Eigen::VectorXd at(n), steps(n);
     for (Eigen::Index k = 0; k < n; ++k) {
         const auto i = static_cast<std::size_t>(k);
-        const auto [lo, hi] = c.names[i] == "tension_scale" || c.names[i] == "beta_scale" ? boundsOf(c.names[i], engine.info())
-                                                                                          : std::pair{c.lo[i], c.hi[i]};
         at[k] = x[i];
-        steps[k] = 0.03 * (hi - lo); // as the final model's curvature intervals
+        steps[k] = 0.03 * (searched.hi[i] - searched.lo[i]); // as the final model's curvature intervals
     }
     auto residuals = [&](const Eigen::VectorXd& y) {
-        const auto e = engine.errors(apply(base, c, std::vector<double>(y.data(), y.data() + y.size())), on);
-        Eigen::VectorXd r(static_cast<Eigen::Index>(e.size()));
-        for (std::size_t i = 0; i < e.size(); ++i) r[static_cast<Eigen::Index>(i)] = e[i].total();
-        return r;
+        return strokeTotals(engine.errors(apply(base, c, std::vector<double>(y.data(), y.data() + y.size())), on));
     };
     const Eigen::MatrixXd cov = curvatureCovariance(residuals, at, steps);
     std::vector<double> hw(c.names.size());
@@ -401,10 +407,7 @@ void addCurvatureIntervals(Diagnosis& d, const Engine& engine, const EffectModel
     auto residuals = [&](const Eigen::VectorXd& y) {
         EffectModel m = current;
         for (std::size_t k = 0; k < names.size(); ++k) m.params[names[k]] = y[static_cast<Eigen::Index>(k)];
-        const auto e = engine.errors(m, fitSet);
-        Eigen::VectorXd r(static_cast<Eigen::Index>(e.size()));
-        for (std::size_t i = 0; i < e.size(); ++i) r[static_cast<Eigen::Index>(i)] = e[i].total();
-        return r;
+        return strokeTotals(engine.errors(m, fitSet));
     };
     const Eigen::MatrixXd cov = curvatureCovariance(residuals, x, steps);
     for (std::size_t k = 0; k < names.size(); ++k) {

@@ -297,12 +297,6 @@ std::string halvesDisagreement(const Candidate& c, const std::vector<double>& lo
     return why;
 }
 
-bool halvesConsistent(const Candidate& c, const std::vector<double>& low, const std::vector<double>& high,
-                      const std::map<std::string, double>& bootstrapHalfWidth)
-{
-    return halvesDisagreement(c, low, high, bootstrapHalfWidth).empty();
-}
-
 EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector<double>& x)
 {
     EffectModel m = base;

@@ -238,17 +238,15 @@ bool atNull(const std::string& effect, const std::map<std::string, double>& p);
 /// range's edge (rule 2's edge condition: a stand-in pushed past what the candidate can express). h0 is not asked:
 /// nothing fixes it, so it ends wherever the search drifted.
 bool pinnedAtEdge(const Candidate& c, const std::vector<double>& x);
-/// Rule 5: refits on the two drive halves agree when neither puts the effect at its absence and
-/// every identifiable parameter of the candidate's own differs between them by at most twice its
-/// bootstrap half-width plus a tenth of its search range.
-bool halvesConsistent(const Candidate& c, const std::vector<double>& low, const std::vector<double>& high,
-                      const std::map<std::string, double>& bootstrapHalfWidth);
 /// 1.96 standard deviations of the bootstrap refits for each of the candidate's own parameters;
 /// the identifiable ones whose refits all came back to the estimate (a spread under 0.1 % of the
 /// search range) are added to `returned`.
 std::vector<double> bootstrapHalfWidths(const Candidate& c, const std::vector<std::vector<double>>& refits, std::set<std::string>& returned);
-/// Why rule 5 refuses: each parameter whose halves differ by more than allowed, with both values
-/// and the allowance, and a half that fits no effect; empty when the halves agree.
+/// Rule 5: refits on the two drive halves agree when neither puts the effect at its absence and
+/// every identifiable parameter of the candidate's own differs between them by at most twice its
+/// bootstrap half-width plus a tenth of its search range. Empty when they agree; otherwise why
+/// not: each parameter too far apart, with both values and the allowance, and a half that fits
+/// no effect.
 std::string halvesDisagreement(const Candidate& c, const std::vector<double>& low, const std::vector<double>& high,
                                const std::map<std::string, double>& bootstrapHalfWidth);
 /// The coarse grid fit() starts from, as (parameter index, points) pairs: 7, 5 or 3 points on
@@ -263,6 +261,10 @@ EffectModel apply(const EffectModel& base, const Candidate& c, const std::vector
 /// [0, 1]-scaled position.
 std::vector<double> secondGridStart(const std::vector<std::pair<double, std::vector<double>>>& points, const std::vector<double>& best,
                                     const std::vector<std::pair<std::size_t, int>>& dims);
+/// The candidate with tension and bow position searched within the set's own priors, wherever it
+/// was built (every fit and every curvature step uses these bounds); a start, when given, is
+/// clamped into them.
+Candidate withinSetPriors(Candidate c, const StringInfo& info, std::vector<double>* start = nullptr);
 /// Fits the candidate's parameters on the strokes `on`: a coarse grid, then COBYLA from its best point
 /// (and, with `secondStart`, from secondGridStart() too, keeping the better end).
 /// Tension and bow position are searched within boundsOf() the engine's set, whatever the candidate says.

@@ -68,17 +68,20 @@ std::vector<double> physical(const Candidate& c, const std::vector<double>& u)
 /// Fits the candidate's parameters on the given strokes. The error surface is rough (transients
 /// are chaotic), so a coarse grid over the bounds comes first and COBYLA refines from its best
 /// point on [0, 1]-scaled variables. `scan` = false skips the grid (warm starts).
+Candidate withinSetPriors(Candidate c, const StringInfo& info, std::vector<double>* start)
+{
+    for (std::size_t k = 0; k < c.names.size(); ++k)
+        if (c.names[k] == "tension_scale" || c.names[k] == "beta_scale") {
+            std::tie(c.lo[k], c.hi[k]) = boundsOf(c.names[k], info);
+            if (start) (*start)[k] = std::clamp((*start)[k], c.lo[k], c.hi[k]);
+        }
+    return c;
+}
+
 std::vector<double> fit(const Engine& engine, const EffectModel& base, const Candidate& asBuilt, const std::vector<std::size_t>& on,
                         std::vector<double> start, int maxEval, double step, double* best, bool scan, bool secondStart)
 {
-    // Every fit searches tension and bow position within the set's own priors, wherever the
-    // candidate was built.
-    Candidate c = asBuilt;
-    for (std::size_t k = 0; k < c.names.size(); ++k)
-        if (c.names[k] == "tension_scale" || c.names[k] == "beta_scale") {
-            std::tie(c.lo[k], c.hi[k]) = boundsOf(c.names[k], engine.info());
-            start[k] = std::clamp(start[k], c.lo[k], c.hi[k]);
-        }
+    const Candidate c = withinSetPriors(asBuilt, engine.info(), &start);
     const std::size_t n = c.names.size();
     std::vector<double> x(n);
     for (std::size_t k = 0; k < n; ++k) x[k] = (start[k] - c.lo[k]) / (c.hi[k] - c.lo[k]);
